@@ -1,0 +1,1 @@
+"""Integrator kernels (compiled; arrays in, arrays and an integer status out)."""

@@ -1,0 +1,1 @@
+"""Models: vector fields, switching surfaces and regions as compiled scalar functions."""

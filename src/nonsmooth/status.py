@@ -1,0 +1,21 @@
+"""Integer status codes returned by every compiled kernel (kernels never raise)."""
+
+OK = 0
+MAX_STEPS = 1
+STEP_TOO_SMALL = 2
+NON_FINITE = 3
+ZENO = 4  # accumulation of ever shorter contacts (exact solver)
+EVENT_FAILED = 5  # an event could not be located (should not happen)
+
+MESSAGES = {
+    OK: "ok",
+    MAX_STEPS: "too many steps",
+    STEP_TOO_SMALL: "step size too small",
+    NON_FINITE: "non-finite state",
+    ZENO: "accumulation of ever shorter contacts (Zeno)",
+    EVENT_FAILED: "event location failed",
+}
+
+
+def message(code: int) -> str:
+    return MESSAGES.get(int(code), f"unknown status {int(code)}")
