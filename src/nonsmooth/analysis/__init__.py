@@ -1,0 +1,1 @@
+"""Analyses: one module each, a per-point core plus a sweep, each returning an xarray.Dataset."""
