@@ -3,12 +3,22 @@
 Public API: :class:`Params`, :func:`preset`, :func:`simulate`, and the analyses.
 """
 
-from ._version import __version__
+from ._numba_cache import configure as _configure_numba_cache
+
+_configure_numba_cache()  # before any compiled module is imported
+
+from ._version import __version__  # noqa: E402
 from .errors import IntegrationError, NonsmoothError, OutputError, ParameterError
 from .kernels import Solver
 from .params import PARAM_NAMES, Params
 from .presets import PRESETS, preset
 from .simulate import simulate
+from .analysis.poincare import poincare
+from .analysis.bifurcation import bifurcation_diagram
+from .analysis.resonance import resonance_curve
+from .analysis.basins import basins
+from .reproduction import reproduce
 
-__all__ = ["__version__", "Params", "PARAM_NAMES", "preset", "PRESETS", "simulate", "Solver",
+__all__ = ["__version__", "Params", "PARAM_NAMES", "preset", "PRESETS", "simulate", "reproduce", "Solver",
+           "poincare", "bifurcation_diagram", "resonance_curve", "basins",
            "NonsmoothError", "ParameterError", "OutputError", "IntegrationError"]

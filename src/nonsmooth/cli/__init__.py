@@ -12,6 +12,9 @@ from .app import app
 
 # Each command module registers its commands on ``app`` when imported.
 from . import simulate  # noqa: E402,F401
+from . import analyses  # noqa: E402,F401
+from . import reproduce  # noqa: E402,F401
+from . import basins  # noqa: E402,F401
 
 
 def main(argv: list[str] | None = None) -> None:

@@ -1,0 +1,57 @@
+"""Benchmark: bifurcation diagram, table3, omega in [0.8, 1.0], 1000 values x (500 transient +
+200 recorded) periods, both sweeps (up and down in parallel), smoothed model.
+
+Run: python benchmarks/bench_bifurcation.py [--values 1000] [--workers N] [--no-settle]
+Throughput is reported in nominal trajectory-periods (values x sweeps x (transient + record))
+per second and in periods actually integrated (the settled transient ends early).
+"""
+
+import argparse
+import os
+import time
+
+import numpy as np
+
+from nonsmooth import preset
+from nonsmooth.analysis.bifurcation import bifurcation_diagram
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--values", type=int, default=1000)
+    ap.add_argument("--transient", type=int, default=500)
+    ap.add_argument("--record", type=int, default=200)
+    ap.add_argument("--workers", type=int, default=None)
+    ap.add_argument("--sweep", default="both")
+    ap.add_argument("--method", default="smooth")
+    ap.add_argument("--no-settle", action="store_true")
+    a = ap.parse_args()
+    params = preset("table3")
+    values = np.linspace(0.8, 1.0, a.values)
+    # warm-up (compilation / cache load)
+    bifurcation_diagram(params, "omega", values[:2], sweep=a.sweep, transient=2, record=2,
+                        method=a.method, workers=a.workers)
+    load0 = os.getloadavg()
+    c0 = time.process_time()
+    t0 = time.perf_counter()
+    ds = bifurcation_diagram(params, "omega", values, sweep=a.sweep, transient=a.transient,
+                             record=a.record, method=a.method, workers=a.workers,
+                             settle=not a.no_settle)
+    dt = time.perf_counter() - t0
+    cpu = time.process_time() - c0
+    load1 = os.getloadavg()
+    nsw = ds.sizes["sweep"]
+    nominal = a.values * nsw * (a.transient + a.record)
+    actual = int(ds.transient_used.sum()) + a.values * nsw * a.record
+    print(f"bifurcation table3 omega [0.8, 1.0], {a.values} values x ({a.transient} + {a.record}) "
+          f"periods, sweep={a.sweep}, method={a.method}, settle={not a.no_settle}, "
+          f"workers={a.workers or 'all'}")
+    print(f"time {dt:.2f} s; nominal {nominal / dt:,.0f} trajectory-periods/s; "
+          f"integrated {actual:,} periods ({actual / nominal:.0%} of nominal), {actual / dt:,.0f} periods/s")
+    print(f"CPU time {cpu:.2f} s (all threads): {actual / cpu:,.0f} periods per CPU-second; "
+          f"on {os.cpu_count()} idle cores expect about {cpu / min(nsw, os.cpu_count()):.1f} s wall")
+    print(f"failed points: {ds.attrs['n_failed']}; loadavg before {load0[0]:.2f}, after {load1[0]:.2f}")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,206 @@
+"""Resonance curves (max X and min X of the settled response versus omega), swept up and down
+with continuation, and the characteristic frequencies of the paper's Fig. 6.
+
+Definitions (all on the ascending grid of ``omegas``; the continuation core is the one of
+:mod:`.bifurcation`):
+
+* The up and down branches *differ* at a grid value when
+  |max_X_up - max_X_down| > ``branch_tol`` (default 1e-3 max(1, |max_X|)).
+* **omega_b, omega_c** (hysteresis): the widest contiguous run of grid values where the
+  branches differ is the hysteresis interval. Its upper end is where the *up* sweep jumps
+  (omega_c: between the last value of the run and the next one), its lower end where the
+  *down* sweep jumps (omega_b: between the first value of the run and the previous one).
+  Each is refined by bisection with continuation: the branch that jumps is continued from its
+  state at the last value where it existed, the other branch from its state at the first value
+  past the jump, both to the midpoint, quasi-statically in steps of at most
+  ``RAMP`` x ``resolution`` (at most ``MAX_RAMP_STEPS`` steps); if they still differ, the jumping branch still exists
+  there, otherwise it has gone. Stops when the bracket is <= ``resolution``; the midpoint is
+  reported, with the bracket in ``omega_b_bracket`` / ``omega_c_bracket``. An end of the run
+  that touches the end of the grid gives NaN (jump outside the range); no differing value
+  gives NaN for both.
+* **omega_a** (contact starts): the smallest grid value at which a branch (up or down) has
+  max_X >= 1 while the same branch had max_X < 1 at the previous value; refined by bisection
+  on max_X - 1 along that (non-contact) branch, continued from its state at the last value
+  below 1. NaN if no branch crosses 1 from below inside the grid.
+
+All results depend on the transient like the sweeps themselves: close to a saddle-node the
+vanishing branch drifts slowly (critical slowing down), so a too-short transient moves the
+refined jump frequencies slightly past the true fold.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import xarray as xr
+
+from ..errors import ParameterError
+from ..kernels import Solver
+from ..params import Params
+from .bifurcation import branches_dataset, check_values, continuation, run_branches
+from .poincare import settle_tolerance
+
+#: During refinement a branch is continued to each bisection midpoint in steps of at most
+#: RAMP x resolution (quasi-static), so that the transient after a finite parameter step
+#: cannot push it off its branch early (with light damping the response overshoots).
+RAMP = 0.25
+#: ... but in at most this many steps per midpoint (coarse grids: the first, long
+#: continuations use longer steps; the last ones, which decide the result, are short).
+MAX_RAMP_STEPS = 32
+
+
+def _continue_to(params, solver, starts, target, states, transient, record, settle_tol,
+                 workers, ramp):
+    """Continue each row of ``states`` (at frequency ``starts[row]``) quasi-statically to
+    ``target`` in equal steps of at most ``ramp`` (all rows take the same number of steps).
+    Returns (max_X at ``target`` per row, states there, ok)."""
+    from ..sweep import threads
+    nbr = states.shape[0]
+    dist = max(abs(target - w) for w in starts)
+    nstep = max(1, min(MAX_RAMP_STEPS, int(math.ceil(dist / ramp - 1e-9))))
+    P = np.empty((nbr, nstep, params.pack().size))
+    for b, w in enumerate(starts):
+        path = np.linspace(w, target, nstep + 1)[1:]
+        path[-1] = target
+        P[b] = np.stack([params.replace(omega=float(x)).pack() for x in path])
+    states = np.array(states, dtype=np.float64, copy=True)
+    X = np.empty((nbr, nstep, record))
+    V, Xmax, Xmin = np.empty_like(X), np.empty_like(X), np.empty_like(X)
+    R = np.empty(X.shape, np.int8)
+    M = np.empty(X.shape, np.uint8)
+    status = np.zeros((nbr, nstep), np.int64)
+    used = np.zeros((nbr, nstep), np.int64)
+    S = np.empty((nbr, nstep, states.shape[1]))
+    with threads(workers):
+        continuation(solver.code, P, solver.opts(), states, states[0].copy(), transient,
+                     settle_tol, X, V, R, M, Xmax, Xmin, status, used, S)
+    return Xmax[:, -1].max(axis=1), S[:, -1], bool(np.all(status == 0))
+
+
+def _differ(a, b, branch_tol):
+    return abs(a - b) > branch_tol * max(1.0, abs(a), abs(b))
+
+
+def _refine_jump(params, solver, w_keep, s_keep, w_gone, s_other, resolution, branch_tol,
+                 run):
+    """Bisection for the end of the branch that exists at w_keep and not at w_gone."""
+    while abs(w_gone - w_keep) > resolution:
+        mid = 0.5 * (w_keep + w_gone)
+        mx, S, ok = _continue_to(params, solver, (w_keep, w_gone), mid,
+                                 np.stack([s_keep, s_other]), *run)
+        if not ok:
+            return float("nan"), (float("nan"), float("nan"))
+        if _differ(mx[0], mx[1], branch_tol):
+            w_keep, s_keep = mid, S[0]
+        else:
+            w_gone, s_other = mid, S[1]
+    lo, hi = sorted((w_keep, w_gone))
+    return 0.5 * (lo + hi), (lo, hi)
+
+
+def _refine_contact(params, solver, w_lo, s_lo, w_hi, resolution, run):
+    """Bisection on max_X - 1 along a branch continued from its state at w_lo (max_X < 1)."""
+    while w_hi - w_lo > resolution:
+        mid = 0.5 * (w_lo + w_hi)
+        mx, S, ok = _continue_to(params, solver, (w_lo,), mid, s_lo[None, :], *run)
+        if not ok:
+            return float("nan"), (float("nan"), float("nan"))
+        if mx[0] < 1.0:
+            w_lo, s_lo = mid, S[0]
+        else:
+            w_hi = mid
+    return 0.5 * (w_lo + w_hi), (w_lo, w_hi)
+
+
+def characteristic_frequencies(params, solver, omegas, out, *, transient, record, settle,
+                               workers, resolution=1e-4, branch_tol=1e-3):
+    """omega_a, omega_b, omega_c and their brackets from up/down branches ``out`` of
+    :func:`run_branches` (branch 0 = up, 1 = down); see the module docstring."""
+    run = (transient, record, settle_tolerance(solver, settle), workers, RAMP * resolution)
+    mx = out["Xmax"].max(axis=2)  # (2, n)
+    up, down = mx[0], mx[1]
+    n = omegas.size
+    res = {"omega_a": math.nan, "omega_b": math.nan, "omega_c": math.nan,
+           "omega_a_bracket": (math.nan, math.nan), "omega_b_bracket": (math.nan, math.nan),
+           "omega_c_bracket": (math.nan, math.nan), "n_hysteresis_intervals": 0,
+           "omega_a_branch": ""}
+    # hysteresis interval: widest run where the branches differ
+    diff = np.array([np.isfinite(up[i]) and np.isfinite(down[i]) and
+                     _differ(up[i], down[i], branch_tol) for i in range(n)])
+    runs, i = [], 0
+    while i < n:
+        if diff[i]:
+            j = i
+            while j + 1 < n and diff[j + 1]:
+                j += 1
+            runs.append((i, j))
+            i = j + 1
+        else:
+            i += 1
+    res["n_hysteresis_intervals"] = len(runs)
+    if runs:
+        i0, i1 = max(runs, key=lambda r: (omegas[r[1]] - omegas[r[0]], -r[0]))
+        S = out["S"]
+        if i1 + 1 < n and np.all(out["status"][:, i1:i1 + 2] == 0):  # up sweep jumps
+            res["omega_c"], res["omega_c_bracket"] = _refine_jump(
+                params, solver, omegas[i1], S[0, i1], omegas[i1 + 1], S[1, i1 + 1],
+                resolution, branch_tol, run)
+        if i0 > 0 and np.all(out["status"][:, i0 - 1:i0 + 1] == 0):  # down sweep jumps
+            res["omega_b"], res["omega_b_bracket"] = _refine_jump(
+                params, solver, omegas[i0], S[1, i0], omegas[i0 - 1], S[0, i0 - 1],
+                resolution, branch_tol, run)
+    # contact onset: first upward crossing of max_X = 1 on either branch
+    best = None
+    for b, name in ((0, "up"), (1, "down")):
+        for i in range(1, n):
+            if mx[b, i - 1] < 1.0 <= mx[b, i]:
+                if best is None or i < best[1]:
+                    best = (b, i, name)
+                break
+    if best is not None:
+        b, i, name = best
+        res["omega_a"], res["omega_a_bracket"] = _refine_contact(
+            params, solver, omegas[i - 1], out["S"][b, i - 1], omegas[i], resolution, run)
+        res["omega_a_branch"] = name
+    return res
+
+
+def resonance_curve(params: Params, omegas, *, method: str = "smooth", transient: int = 500,
+                    record: int = 50, x0: float = 0.0, v0: float = 0.0, rtol: float = 1e-8,
+                    atol: float = 1e-10, transition: str = "eq13", settle: bool = True,
+                    resolution: float = 1e-4, branch_tol: float = 1e-3,
+                    workers: int | None = None, progress=None) -> xr.Dataset:
+    """Resonance curve over the forcing frequencies ``omegas`` (sorted ascending), swept up and
+    down with continuation (see :func:`.bifurcation.bifurcation_diagram` for transient, record,
+    settle). Returns a Dataset over (sweep, omega) with ``max_X``, ``min_X``, ``period``,
+    ``contact``, ``status`` and the section ``X``, ``V``; attrs ``omega_a``, ``omega_b``,
+    ``omega_c`` (NaN when absent) refined to ``resolution``, with ``*_bracket`` attrs
+    (definitions in the module docstring)."""
+    from ..simulate import check_float, check_int, check_params
+    params = check_params(params)
+    omegas = check_values("omega", omegas)
+    for w in (omegas[0], omegas[-1]):
+        params.replace(omega=float(w))
+    transient = check_int("transient", transient, 0)
+    record = check_int("record", record, 1)
+    x0 = check_float("x0", x0)
+    v0 = check_float("v0", v0)
+    resolution = check_float("resolution", resolution)
+    if resolution <= 0:
+        raise ParameterError(f"resolution: must be > 0, got {resolution}")
+    branch_tol = check_float("branch_tol", branch_tol)
+    if branch_tol <= 0:
+        raise ParameterError(f"branch_tol: must be > 0, got {branch_tol}")
+    solver = Solver(method=method, rtol=rtol, atol=atol, transition=transition)
+    out = run_branches(params, "omega", omegas, solver, directions=["up", "down"],
+                       transient=transient, record=record, x0=x0, v0=v0, settle=settle,
+                       workers=workers, progress=progress)
+    freqs = characteristic_frequencies(params, solver, omegas, out, transient=transient,
+                                       record=record, settle=settle, workers=workers,
+                                       resolution=resolution, branch_tol=branch_tol)
+    ds = branches_dataset(params, "omega", omegas, solver, ["up", "down"], out,
+                          analysis="resonance", transient=transient, record=record, x0=x0,
+                          v0=v0, settle=settle, resolution=resolution, branch_tol=branch_tol,
+                          **freqs)
+    return ds

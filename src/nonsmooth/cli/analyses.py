@@ -1,0 +1,192 @@
+"""`nonsmooth poincare`, `nonsmooth bifurcation`, `nonsmooth resonance`."""
+
+from __future__ import annotations
+
+import math
+from typing import Annotated
+
+import typer
+
+from ..errors import ParameterError
+from .app import app
+from .common import (AtolOpt, MethodOpt, OutOpt, PlotOpt, PresetOpt, RtolOpt, SetOpt,
+                     TransitionOpt, WorkersOpt, check_outputs, echo_written, load_params,
+                     require_output)
+
+FromOpt = Annotated[float, typer.Option("--from", help="first value of the range")]
+ToOpt = Annotated[float, typer.Option("--to", help="last value of the range")]
+StepsOpt = Annotated[int, typer.Option("--steps", help="number of values (>= 2)")]
+TransientOpt = Annotated[int, typer.Option("--transient", help="forcing periods discarded first")]
+X0Opt = Annotated[float, typer.Option("--x0", help="initial X")]
+V0Opt = Annotated[float, typer.Option("--v0", help="initial V")]
+SettleOpt = Annotated[bool, typer.Option(
+    "--settle/--no-settle", help="end the transient early once the section has provably settled")]
+
+
+def value_range(lo: float, hi: float, steps: int, name: str = "range"):
+    """Evenly spaced values lo ... hi (validated: finite, lo < hi, steps >= 2)."""
+    import numpy as np
+    for field, v in (("from", lo), ("to", hi)):
+        if not math.isfinite(v):
+            raise ParameterError(f"{field}: must be finite, got {v}")
+    if not lo < hi:
+        raise ParameterError(f"from/to: empty or reversed {name}: --from {lo:g} must be < --to {hi:g}")
+    if steps < 2:
+        raise ParameterError(f"steps: must be >= 2, got {steps}")
+    return np.linspace(lo, hi, steps)
+
+
+def _progress(text: str):
+    from ..sweep import Progress
+    return Progress(text)
+
+
+@app.command("poincare")
+def poincare_cmd(
+    preset: PresetOpt = "table3",
+    set_: SetOpt = None,
+    points: Annotated[int, typer.Option("--points", help="section points recorded")] = 2000,
+    transient: TransientOpt = 500,
+    x0: X0Opt = 0.0,
+    v0: V0Opt = 0.0,
+    method: MethodOpt = "smooth",
+    rtol: RtolOpt = 1e-8,
+    atol: AtolOpt = 1e-10,
+    transition: TransitionOpt = "eq13",
+    orbit_samples: Annotated[int, typer.Option(help="phase-portrait samples per period")] = 200,
+    out: OutOpt = None,
+    plot: PlotOpt = None,
+):
+    """Stroboscopic Poincaré map (t = kT) with period and contact classification; plot like
+    Figs. 10 and 12 (phase portrait with its section points, and the map)."""
+    from ..analysis.poincare import poincare
+    from ..io import save_dataset, save_figure
+    from ..simulate import check_int
+
+    params = load_params(preset, set_)
+    check_int("points", points, 1)
+    check_int("transient", transient, 0)
+    require_output(out, plot)
+    check_outputs(out, plot)
+    ds = poincare(params, points=points, transient=transient, x0=x0, v0=v0, method=method,
+                  rtol=rtol, atol=atol, transition=transition, orbit_samples=orbit_samples)
+    ds.attrs["preset"] = preset
+    if out is not None:
+        save_dataset(ds, out)
+    if plot is not None:
+        from ..plot.poincare import plot_poincare
+        save_figure(plot_poincare(ds), plot)
+    a = ds.attrs
+    kind = f"period {a['period']}" if a["period"] else "not periodic (period 0)"
+    typer.echo(f"{preset}: {kind}, contact {a['contact']}, max X = {a['max_X']:.6g}, "
+               f"min X = {a['min_X']:.6g}")
+    echo_written(out, plot)
+
+
+@app.command("bifurcation")
+def bifurcation_cmd(
+    preset: PresetOpt = "table3",
+    set_: SetOpt = None,
+    param: Annotated[str, typer.Option("--param", help="swept parameter")] = "omega",
+    from_: FromOpt = 0.8,
+    to: ToOpt = 1.0,
+    steps: StepsOpt = 400,
+    sweep: Annotated[str, typer.Option("--sweep", help="up, down, both or fresh")] = "both",
+    transient: TransientOpt = 500,
+    record: Annotated[int, typer.Option("--record", help="section points recorded per value")] = 200,
+    x0: X0Opt = 0.0,
+    v0: V0Opt = 0.0,
+    method: MethodOpt = "smooth",
+    rtol: RtolOpt = 1e-8,
+    atol: AtolOpt = 1e-10,
+    transition: TransitionOpt = "eq13",
+    settle: SettleOpt = True,
+    workers: WorkersOpt = None,
+    out: OutOpt = None,
+    plot: PlotOpt = None,
+):
+    """Bifurcation diagram of the section X(kT) over a parameter (Figs. 9 and 11)."""
+    from ..analysis.bifurcation import SWEEPS, bifurcation_diagram
+    from ..io import save_dataset, save_figure
+    from ..params import check_param_name
+    from ..simulate import check_int
+
+    params = load_params(preset, set_)
+    param = check_param_name(param)
+    if sweep not in SWEEPS:
+        raise ParameterError(f"sweep: unknown sweep {sweep!r} (known: {', '.join(SWEEPS)})")
+    values = value_range(from_, to, steps, f"{param} range")
+    for v in (values[0], values[-1]):
+        params.replace(**{param: float(v)})
+    check_int("transient", transient, 0)
+    check_int("record", record, 1)
+    require_output(out, plot)
+    check_outputs(out, plot)
+    with _progress(f"bifurcation {param} ({sweep})") as prog:
+        ds = bifurcation_diagram(params, param, values, sweep=sweep, transient=transient,
+                                 record=record, method=method, x0=x0, v0=v0, rtol=rtol,
+                                 atol=atol, transition=transition, settle=settle,
+                                 workers=workers, progress=prog)
+    ds.attrs["preset"] = preset
+    if out is not None:
+        save_dataset(ds, out)
+    if plot is not None:
+        from ..plot.bifurcation import plot_bifurcation
+        save_figure(plot_bifurcation(ds), plot)
+    per = ds.period.values
+    typer.echo(f"{preset}: {param} {from_:g} ... {to:g}, {steps} values, sweep {sweep}: "
+               f"{int((per == 0).sum())} non-periodic, {int((per > 0).sum())} periodic, "
+               f"{ds.attrs['n_failed']} failed")
+    echo_written(out, plot)
+
+
+@app.command("resonance")
+def resonance_cmd(
+    preset: PresetOpt = "fig6a",
+    set_: SetOpt = None,
+    from_: FromOpt = 0.5,
+    to: ToOpt = 1.6,
+    steps: StepsOpt = 400,
+    transient: TransientOpt = 500,
+    record: Annotated[int, typer.Option("--record", help="periods recorded per value")] = 50,
+    x0: X0Opt = 0.0,
+    v0: V0Opt = 0.0,
+    method: MethodOpt = "smooth",
+    rtol: RtolOpt = 1e-8,
+    atol: AtolOpt = 1e-10,
+    transition: TransitionOpt = "eq13",
+    settle: SettleOpt = True,
+    resolution: Annotated[float, typer.Option(help="bisection resolution of omega_a/b/c")] = 1e-4,
+    workers: WorkersOpt = None,
+    out: OutOpt = None,
+    plot: PlotOpt = None,
+):
+    """Resonance curve (max X, min X versus omega, swept up and down with continuation) and
+    the frequencies omega_a (contact starts), omega_b, omega_c (jumps), like Fig. 6."""
+    from ..analysis.resonance import resonance_curve
+    from ..io import save_dataset, save_figure
+    from ..simulate import check_int
+
+    params = load_params(preset, set_)
+    omegas = value_range(from_, to, steps, "omega range")
+    for v in (omegas[0], omegas[-1]):
+        params.replace(omega=float(v))
+    check_int("transient", transient, 0)
+    check_int("record", record, 1)
+    require_output(out, plot)
+    check_outputs(out, plot)
+    with _progress("resonance (up and down)") as prog:
+        ds = resonance_curve(params, omegas, method=method, transient=transient, record=record,
+                             x0=x0, v0=v0, rtol=rtol, atol=atol, transition=transition,
+                             settle=settle, resolution=resolution, workers=workers,
+                             progress=prog)
+    ds.attrs["preset"] = preset
+    if out is not None:
+        save_dataset(ds, out)
+    if plot is not None:
+        from ..plot.resonance import plot_resonance
+        save_figure(plot_resonance(ds), plot)
+    a = ds.attrs
+    typer.echo(f"{preset}: omega_a = {a['omega_a']:.5f} (contact starts), "
+               f"omega_b = {a['omega_b']:.5f}, omega_c = {a['omega_c']:.5f} (jumps; NaN = none)")
+    echo_written(out, plot)

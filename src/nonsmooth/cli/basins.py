@@ -1,0 +1,67 @@
+"""`nonsmooth basins`: basins of attraction on a grid of initial conditions (Figs. 7 and 8)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Annotated, Optional
+
+import typer
+
+from .app import app
+from .common import (AtolOpt, MethodOpt, OutOpt, PlotOpt, PresetOpt, RtolOpt, SetOpt, TransitionOpt,
+                     WorkersOpt, check_outputs, echo_written, load_params, require_output)
+
+
+@app.command("basins")
+def basins_cmd(
+    preset: PresetOpt = "fig7",
+    set_: SetOpt = None,
+    x: Annotated[tuple[float, float], typer.Option("--x", help="range of the initial X: MIN MAX")] = (-3.0, 3.0),
+    v: Annotated[tuple[float, float], typer.Option("--v", help="range of the initial V: MIN MAX")] = (-3.0, 3.0),
+    grid: Annotated[int, typer.Option("--grid", help="initial conditions per axis (>= 2)")] = 400,
+    max_periods: Annotated[int, typer.Option("--max-periods", help="forcing periods allowed per initial condition")] = 1000,
+    transient: Annotated[int, typer.Option("--transient", help="periods before periodicity is tested")] = 10,
+    max_period: Annotated[int, typer.Option("--max-period", help="longest period looked for")] = 16,
+    no_early_stop: Annotated[bool, typer.Option("--no-early-stop", help="integrate every point until periodic (slow reference)")] = False,
+    method: MethodOpt = "smooth",
+    rtol: RtolOpt = 1e-8,
+    atol: AtolOpt = 1e-10,
+    transition: TransitionOpt = "eq13",
+    workers: WorkersOpt = None,
+    out: OutOpt = None,
+    plot: PlotOpt = None,
+    orbits_plot: Annotated[Optional[Path], typer.Option("--orbits-plot", help="figure of the coexisting orbits (Fig. 8)")] = None,
+):
+    """Basins of attraction (attractors found automatically); a Fig. 7-style image and a Fig. 8-style
+    figure of the coexisting periodic orbits."""
+    from ..analysis.basins import basins
+    from ..io import check_writable, save_dataset, save_figure
+    from ..sweep import Progress
+
+    params = load_params(preset, set_)
+    require_output(out, plot if plot is not None else orbits_plot)
+    check_outputs(out, plot)
+    if orbits_plot is not None:
+        check_writable(orbits_plot, "orbits-plot")
+    with Progress("basins") as bar:
+        ds = basins(params, x=x, v=v, grid=grid, method=method, transient=transient,
+                    max_periods=max_periods, max_period=max_period, rtol=rtol, atol=atol,
+                    transition=transition, early_stop=not no_early_stop, workers=workers,
+                    progress=bar)
+    ds.attrs["preset"] = preset
+    if out is not None:
+        save_dataset(ds, out)
+    if plot is not None:
+        from ..plot.basins import plot_basins
+        save_figure(plot_basins(ds), plot)
+    if orbits_plot is not None:
+        from ..plot.basins import plot_attractors
+        save_figure(plot_attractors(ds), orbits_plot)
+    n = ds.sizes["attractor"]
+    typer.echo(f"{preset}: {ds.attrs['grid_nx']}x{ds.attrs['grid_nv']} initial conditions, "
+               f"{n} attractor(s), undecided {100 * ds.attrs['undecided_fraction']:.2f}%, "
+               f"{ds.attrs['mean_periods_used']:.2f} periods per point on average")
+    for k in range(n):
+        typer.echo(f"  A{k}: period {int(ds.period[k])}, contact {int(ds.contact[k])}, "
+                   f"max X {float(ds.max_X[k]):.6g}, fraction {float(ds.fraction[k]):.4f}")
+    echo_written(out, plot, orbits_plot)

@@ -1,0 +1,43 @@
+"""Resonance curve with both sweep branches and omega_a, omega_b, omega_c marked (Fig. 6)."""
+
+from __future__ import annotations
+
+import math
+
+import matplotlib.pyplot as plt
+
+from .bifurcation import SWEEP_STYLE, _others
+from .common import param_title
+
+
+def plot_resonance(ds, show_min: bool = True):
+    """max X (and min X) of the settled response versus omega for the up and the down sweep,
+    with vertical lines at omega_a (contact starts), omega_b and omega_c (jumps)."""
+    fig, ax = plt.subplots(figsize=(8, 5))
+    w = ds.omega.values
+    for j, name in enumerate(ds.sweep.values):
+        style = dict(SWEEP_STYLE.get(str(name), dict(color="0.3", marker=".", label=str(name))))
+        ls = "-" if str(name) == "up" else "--"
+        ax.plot(w, ds.max_X.values[j], ls=ls, lw=1.0, markersize=3, **style)
+        if show_min:
+            style.pop("label")
+            ax.plot(w, ds.min_X.values[j], ls=ls, lw=0.8, markersize=2, alpha=0.6, **style)
+    ax.axhline(1.0, color="k", lw=0.6, ls=":", label=r"support $X = 1$")
+    for key, sym, col in (("omega_a", r"\omega_a", "#2ca02c"), ("omega_b", r"\omega_b", "#9467bd"),
+                          ("omega_c", r"\omega_c", "#8c564b")):
+        v = float(ds.attrs.get(key, math.nan))
+        if math.isfinite(v):
+            ax.axvline(v, color=col, lw=0.9, ls="-.")
+            ax.annotate(f"${sym} = {v:.4f}$", xy=(v, 0.03), xycoords=("data", "axes fraction"),
+                        xytext=(3, 0), textcoords="offset points", rotation=90, va="bottom",
+                        fontsize=8, color=col,
+                        bbox=dict(boxstyle="round,pad=0.15", fc="white", ec="none", alpha=0.85))
+    ax.set_xlabel(r"$\omega$ [rad/s]")
+    ax.set_ylabel(r"$\max X$, $\min X$" if show_min else r"$\max X$")
+    ax.set_xlim(w[0], w[-1])
+    ax.set_title("resonance curve (continuation up and down)", fontsize=10)
+    ax.legend(loc="upper left", fontsize=8)
+    ax.grid(True, lw=0.3, alpha=0.5)
+    fig.suptitle(f"{ds.attrs.get('method', '')}: {param_title(ds, _others('omega'))}", fontsize=9)
+    fig.tight_layout()
+    return fig

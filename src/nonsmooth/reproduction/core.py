@@ -1,0 +1,214 @@
+"""The reproduction framework: a registry of figures, checks with computed verdicts, and a runner
+that times every figure and records its failure instead of stopping.
+
+A figure entry is a function ``entry(ctx, rec)`` registered with :func:`figure`. It computes its
+Dataset(s) by calling the library's analyses, saves them with ``ctx.save`` / ``ctx.savefig``, and
+records what it measured with ``rec.check(...)``. Verdicts are computed by the helpers below from
+the measured numbers, never written in by hand.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+import traceback
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Callable
+
+AGREES = "agrees"
+DIFFERS = "differs"
+NOT_STATED = "not stated"
+VERDICTS = (AGREES, DIFFERS, NOT_STATED)
+
+
+@dataclass
+class Check:
+    """One claim of the paper (or a measured fact the paper does not state) beside our result."""
+
+    claim: str
+    measured: str
+    verdict: str
+    evidence: str = ""
+
+    def __post_init__(self):
+        if self.verdict not in VERDICTS:
+            raise ValueError(f"verdict: must be one of {VERDICTS}, got {self.verdict!r}")
+
+
+@dataclass
+class FigureRecord:
+    """Everything the report says about one figure."""
+
+    id: str
+    title: str
+    params: dict = field(default_factory=dict)
+    method: str = ""
+    settings: dict = field(default_factory=dict)
+    checks: list = field(default_factory=list)
+    notes: list = field(default_factory=list)
+    files: list = field(default_factory=list)
+    seconds: float = 0.0
+    error: str = ""
+    traceback: str = ""
+
+    # -- recording helpers -------------------------------------------------------------
+    def check(self, claim: str, measured: str, verdict: str, evidence: str = "") -> Check:
+        c = Check(claim, measured, verdict, evidence)
+        self.checks.append(c)
+        return c
+
+    def note(self, text: str) -> None:
+        self.notes.append(text)
+
+    def use_params(self, params, **labels) -> None:
+        """Record the parameter set (``labels`` add e.g. preset names or swept ranges)."""
+        self.params = {k: f"{v:.6g}" for k, v in params.as_dict().items()}
+        self.params.update({k: str(v) for k, v in labels.items()})
+
+    @property
+    def ok(self) -> bool:
+        return not self.error
+
+    def counts(self) -> dict:
+        out = {v: 0 for v in VERDICTS}
+        for c in self.checks:
+            out[c.verdict] += 1
+        return out
+
+
+@dataclass(frozen=True)
+class FigureSpec:
+    id: str
+    title: str
+    claim: str  # the paper's headline claim for this figure, one line
+    entry: Callable
+    cost: float = 1.0  # rough relative cost (only for ordering messages)
+
+
+#: figure id -> spec, in paper order (filled by ``figures.py``)
+FIGURES: dict[str, FigureSpec] = {}
+
+
+def figure(id: str, title: str, claim: str, cost: float = 1.0):
+    """Decorator registering ``entry(ctx, rec)`` as the reproduction of figure ``id``."""
+
+    def deco(fn):
+        FIGURES[id] = FigureSpec(id, title, claim, fn, cost)
+        return fn
+
+    return deco
+
+
+class Context:
+    """What a figure entry gets: the output folder, the mode, a per-run cache of shared results
+    (e.g. Fig. 8 reuses the basins of Fig. 7a) and the current record for saved files."""
+
+    def __init__(self, out: Path, quick: bool = False, workers: int | None = None,
+                 log: Callable[[str], None] | None = None):
+        self.out = Path(out)
+        self.quick = bool(quick)
+        self.workers = workers
+        self.log = log or (lambda msg: None)
+        self.cache: dict = {}
+        self.current: FigureRecord | None = None
+
+    def pick(self, full, quick):
+        """``quick`` value in --quick mode, else ``full``."""
+        return quick if self.quick else full
+
+    def shared(self, key: str, compute: Callable):
+        """Compute once per run; later figures get the same object (errors are re-raised)."""
+        if key not in self.cache:
+            try:
+                self.cache[key] = ("ok", compute())
+            except Exception as exc:  # noqa: BLE001 - re-raised for every user of the result
+                self.cache[key] = ("error", exc)
+        kind, value = self.cache[key]
+        if kind == "error":
+            raise value
+        return value
+
+    def _record(self, path: Path) -> Path:
+        if self.current is not None:
+            self.current.files.append(path)
+        return path
+
+    def save(self, ds, name: str) -> Path:
+        from ..io import save_dataset
+        p = self.out / f"{name}.nc"
+        if p.exists():
+            p.unlink()
+        save_dataset(ds, p)
+        return self._record(p)
+
+    def savefig(self, fig, name: str) -> Path:
+        from ..io import save_figure
+        p = self.out / f"{name}.png"
+        save_figure(fig, p, dpi=110)
+        return self._record(p)
+
+
+def run_figures(ids, ctx: Context) -> list[FigureRecord]:
+    """Run the figures ``ids`` in order; a failing figure gets its error recorded, the run goes on."""
+    records = []
+    for fid in ids:
+        spec = FIGURES[fid]
+        rec = FigureRecord(fid, spec.title)
+        ctx.current = rec
+        ctx.log(f"{fid}: {spec.title} ...")
+        t0 = time.perf_counter()
+        try:
+            spec.entry(ctx, rec)
+        except Exception as exc:  # noqa: BLE001 - one figure never stops the run
+            rec.error = f"{type(exc).__name__}: {exc}".strip()
+            rec.traceback = traceback.format_exc(limit=6)
+        finally:
+            rec.seconds = time.perf_counter() - t0
+            ctx.current = None
+        if rec.ok and not any(str(f).endswith(".png") for f in rec.files):
+            rec.error = "no PNG figure was produced"
+        if rec.ok and not any(str(f).endswith(".nc") for f in rec.files):
+            rec.error = "no netCDF data file was produced"
+        c = rec.counts()
+        status = f"FAILED ({rec.error})" if rec.error else (
+            f"{c[AGREES]} agree, {c[DIFFERS]} differ, {c[NOT_STATED]} not stated")
+        ctx.log(f"{fid}: {rec.seconds:.1f} s, {status}")
+        records.append(rec)
+    return records
+
+
+# -- verdict helpers (every verdict in the report comes from one of these) -------------------
+def agree_if(condition) -> str:
+    """AGREES when ``condition`` is true, DIFFERS otherwise (None or NaN = DIFFERS)."""
+    try:
+        return AGREES if bool(condition) else DIFFERS
+    except (TypeError, ValueError):
+        return DIFFERS
+
+
+def period_text(p) -> str:
+    """'period 3', 'not periodic (chaotic/quasi-periodic)', or 'unknown'."""
+    if p is None or (isinstance(p, float) and math.isnan(p)):
+        return "unknown"
+    p = int(p)
+    if p == 0:
+        return "not periodic (period 0: chaotic or quasi-periodic)"
+    return f"period {p}"
+
+
+def verdict_period(claimed: int, measured) -> str:
+    """Claimed period (0 = chaotic) against the detected one."""
+    if measured is None:
+        return DIFFERS
+    return agree_if(int(measured) == int(claimed))
+
+
+def fmt(x, digits: int = 4) -> str:
+    try:
+        x = float(x)
+    except (TypeError, ValueError):
+        return str(x)
+    if math.isnan(x):
+        return "NaN"
+    return f"{x:.{digits}g}"
