@@ -40,5 +40,19 @@ def configure() -> str | None:
         except OSError:
             continue
         numba.config.CACHE_DIR = str(d)
+        _prune(parent, keep=d)
         return str(d)
     return None
+
+
+def _prune(parent: Path, keep: Path, n_keep: int = 4) -> None:
+    """Remove all but the ``n_keep`` most recently used cache directories of older sources."""
+    import shutil
+
+    try:
+        dirs = sorted((p for p in parent.glob("numba-*") if p.is_dir() and p != keep),
+                      key=lambda p: p.stat().st_mtime, reverse=True)
+        for old in dirs[n_keep - 1:]:
+            shutil.rmtree(old, ignore_errors=True)
+    except OSError:
+        pass
