@@ -151,11 +151,11 @@ def test_bifurcation_dataset_layout_and_hysteresis_order(tmp_path):
 
 def test_failed_point_is_marked_and_the_rest_completes():
     p = ns.preset("table3")
-    # 150 steps per period suffice for small F0, not for F0 = 1 (contacts)
-    ds = bifurcation_diagram(p, "F0", [0.05, 0.1, 1.0], sweep="down", transient=30, record=5,
-                             max_steps=150)
+    # F0 = 1e308 overflows: the kernel reports a non-finite state; the down sweep starts
+    # there and must restart and finish the other two values
+    ds = bifurcation_diagram(p, "F0", [0.05, 0.1, 1e308], sweep="down", transient=30, record=5)
     st = ds.status.values[0]
-    assert st[2] == ns.status.MAX_STEPS
+    assert st[2] in (ns.status.NON_FINITE, ns.status.STEP_TOO_SMALL)
     assert np.all(np.isnan(ds.X.values[0, 2])) and math.isnan(ds.max_X.values[0, 2])
     assert st[0] == 0 and st[1] == 0 and np.all(np.isfinite(ds.X.values[0, :2]))
     assert ds.attrs["n_failed"] == 1

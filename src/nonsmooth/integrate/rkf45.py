@@ -255,6 +255,8 @@ def advance_smooth(p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_ou
             sx = atol + rtol * max(abs(X), abs(X1))
             sv = atol + rtol * max(abs(V), abs(V1))
             err2 = 0.5 * ((eX / sx) ** 2 + (eV / sv) ** 2)  # squared RMS error norm
+            if not (math.isfinite(X1) and math.isfinite(V1)):
+                err2 = np.nan  # an overflow makes sx infinite and err2 zero: never accept it
             if not err2 <= 1.0:
                 finite = math.isfinite(err2)
                 fac = max(_FAC_MIN, _SAFETY * pow_fast(err2, -0.5 * _EXPO)) if finite else _FAC_MIN
