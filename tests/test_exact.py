@@ -283,3 +283,30 @@ def test_smoothed_model_converges_to_exact_as_eta_shrinks():
     assert all(a > b for a, b in zip(dist, dist[1:]))  # monotone
     assert dist[-1] < 1e-8
     assert np.all(orders[1:] > 1.8)  # second order in eta for the eq. 13 transition
+
+
+@pytest.mark.parametrize("xi,xi_s", [(2.0, 6.0),                        # critical free, over contact
+                                     (2.0, 2.0 * math.sqrt(10.0) - 2.0),  # critical contact
+                                     (3.0, 0.5)])                        # overdamped free flight
+def test_critically_and_overdamped_modes_match_scipy(xi, xi_s):
+    p = Params(omega0=1.0, omega_s=3.0, xi=xi, xi_s=xi_s, F0=5.0, omega=1.0)
+    code, out = run(p, 10)
+    assert code == st.OK
+    Xr, Vr, n_contacts = reference(p, 0.0, 0.0, 10 * p.period)
+    assert n_contacts >= 5 and np.all(out["M"][1:] & 8)
+    assert abs(out["X"][-1] - Xr) <= 1e-9 and abs(out["V"][-1] - Vr) <= 1e-9
+
+
+@pytest.mark.parametrize("F0", [1.0, 1.0 + 1e-12, 1.0 - 1e-12])
+@pytest.mark.parametrize("xi_s", [0.6, 0.0])
+def test_degenerate_corner_starts_end_with_a_status(F0, xi_s):
+    # X = 1, V = 0 with X'' = 0 (or 1e-12) at t = 0: both switching surfaces and the field's
+    # first derivatives vanish together. Must end quickly with a status, never hang.
+    import time
+    p = Params(omega0=1.0, omega_s=17.32, xi=0.0, xi_s=xi_s, F0=F0, omega=0.92)
+    t0 = time.perf_counter()
+    code, out = run(p, 4, per_period=4, x0=1.0, v0=0.0)
+    assert time.perf_counter() - t0 < 5.0
+    assert code in (st.OK, st.ZENO, st.MAX_STEPS)
+    if code == st.OK:
+        assert np.all(np.isfinite(out["X"]))

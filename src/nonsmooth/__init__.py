@@ -17,8 +17,9 @@ from .analysis.poincare import poincare
 from .analysis.bifurcation import bifurcation_diagram
 from .analysis.resonance import resonance_curve
 from .analysis.basins import basins
+from .analysis.eta_study import eta_study
 from .reproduction import reproduce
 
 __all__ = ["__version__", "Params", "PARAM_NAMES", "preset", "PRESETS", "simulate", "reproduce", "Solver",
-           "poincare", "bifurcation_diagram", "resonance_curve", "basins",
+           "eta_study", "poincare", "bifurcation_diagram", "resonance_curve", "basins",
            "NonsmoothError", "ParameterError", "OutputError", "IntegrationError"]

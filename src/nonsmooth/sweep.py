@@ -32,6 +32,8 @@ def _run_many(method, P, opts, states, per_period, n_skip, n_out, X, V, R, M, Xm
                 V[i, k] = np.nan
                 Xmax[i, k] = np.nan
                 Xmin[i, k] = np.nan
+                R[i, k] = -1
+                M[i, k] = 0
 
 
 def resolve_workers(workers: int | None) -> int:

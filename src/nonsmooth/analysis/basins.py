@@ -10,9 +10,9 @@ section points, their period, whether they reach the support).
 Algorithm
 ---------
 1. **Order.** The grid points are visited in a fixed coarse-to-fine order (the points of a coarse
-   sub-grid first, then the points of ever finer sub-grids) and processed in *rounds* of
-   growing size (16, 64, 256 ... points, at most ``_CHUNK_MAX``). The order and the round
-   boundaries depend only on the grid.
+   sub-grid (4 to 8 points per axis) first, then the points of ever finer sub-grids) and
+   processed in *rounds*: the coarse sub-grid, then rounds 4 times larger each time, at most
+   ``_CHUNK_MAX`` points. The order and the round boundaries depend only on the grid.
 2. **Per point** (compiled, all rounds run in parallel over their points): the trajectory is
    advanced one forcing period at a time (``kernels.advance`` with ``per_period=1``). After
    each period its section point is
@@ -30,24 +30,31 @@ Algorithm
    ``max_periods`` periods gets label -1.
 3. **Merge** (serial, in the fixed order of the points): a candidate with the period and the
    set of section points (any cyclic order, within ``match_tol = 100 tol``) of a known
-   attractor gets its label; otherwise it becomes a new attractor, which later rounds use.
+   attractor gets its label (also when its period is a multiple of the attractor's: a slowly
+   converging orbit with a multiplier near -1 passes the test for 2q first); otherwise its
+   points are refined by following it further and its period is re-detected on them
+   (``_polish``), and unless it now matches a known attractor it becomes a new attractor,
+   which later rounds use.
    Labels are finally renumbered in a canonical order (no contact first, then by period, then
    by largest X), so the result never depends on the number of workers or on thread timing:
    within a round each point depends only on its own initial condition and the attractors
    known before the round.
 4. **Capture balls (the early stop).** For each point a_i of a new attractor of period p the
-   largest radius r (starting at half the distance to the nearest other attractor point,
-   at most ``_R_MAX``, halved on failure) is sought such that, for every radius
-   r_j = r c^j (c = ``_SHRINK``) down to ``_R_END``, the circle of radius r_j around a_i,
-   sampled by ``_N_CIRCLE`` points, is mapped by f^(m p) (f = the stroboscopic map, m <= 
-   ``_M_MAX`` the first multiple that works) strictly inside the disc of radius c r_j around
-   a_i, with a margin of half the largest gap between neighbouring image points. The
-   stroboscopic map is a homeomorphism of the plane, so the image of the disc is the inside of
-   the image of its circle: the disc B(a_i, r_j) is mapped into B(a_i, r_{j+1}) and by induction
-   every point of B(a_i, r) converges to within ``_R_END`` (far below the grid spacing) of a_i,
-   i.e. lies in the basin of the attractor. A trajectory that enters such a ball therefore
-   needs no further integration; this is the speed lever (the periods each point needed are
-   returned as ``periods_used``). With ``early_stop=False`` no ball is used and every point runs
+   largest radius r is sought (starting just below the distance to the nearest other attractor
+   point, at most ``_R_MAX``, multiplied by ``_RETRY`` on failure, deterministic) such that,
+   for every radius r_j = r c^j (c = ``_SHRINK``) down to r_end = max(``_R_END``, 10 tol), the
+   circle of radius r_j around a_i, sampled by ``_N_CIRCLE`` points, is mapped by f^(m p)
+   (f = the stroboscopic map, m <= ``_M_MAX`` the first multiple that works) inside the disc
+   of radius c r_j around a_i, with a margin of half the largest gap between neighbouring
+   image points. The stroboscopic map is a homeomorphism of the plane, so the image of a disc
+   is the inside of the image of its circle: B(a_i, r_j) is mapped into B(a_i, r_{j+1}), and by
+   induction every point of B(a_i, r) ends within r_end of a_i (where the linearization rules)
+   -- the disc lies in the attractor's basin, and it cannot contain another attractor. A
+   trajectory that enters such a disc needs no further integration: this is the speed lever
+   (``periods_used`` shows it; ``capture_radius`` gives the radii; 0 = none certified, e.g.
+   a weakly contracting orbit, whose points then run until their section is periodic). The
+   proof is up to the sampling of the circles (the margin covers curvature between samples
+   of a smooth image curve). With ``early_stop=False`` no disc is used and every point runs
    until its section is periodic (the slow reference the tests compare with).
 
 The attractors' periodic orbits are resampled (``samples_per_period`` points per forcing period
@@ -63,7 +70,7 @@ import numpy as np
 import xarray as xr
 
 from ..errors import ParameterError
-from ..integrate.contract import N_STATE, ST_MODE, ST_V, ST_VA, ST_X, ST_H
+from ..integrate.contract import N_STATE, ST_H, ST_MODE, ST_V, ST_VA, ST_X
 from ..io import provenance_attrs
 from ..kernels import Solver, advance
 from ..params import Params
@@ -267,8 +274,9 @@ def _certify(solver, pk, a, r_start, period, tol, cert):
     return 0.0
 
 
-def _coarse_to_fine_order(nx: int, nv: int) -> np.ndarray:
-    """Flat indices (ix * nv + iv) ordered coarse sub-grids first, then by index."""
+def _coarse_to_fine_order(nx: int, nv: int):
+    """Flat indices (ix * nv + iv) ordered coarse sub-grids first, then by index; and the
+    number of points of the coarsest sub-grid (the first round)."""
     L = max(0, int(math.floor(math.log2(max(nx, nv) / 4.0))))
     ix, iv = np.meshgrid(np.arange(nx), np.arange(nv), indexing="ij")
 
@@ -280,11 +288,11 @@ def _coarse_to_fine_order(nx: int, nv: int) -> np.ndarray:
 
     level = np.minimum(tz(ix), tz(iv)).ravel()
     idx = np.arange(nx * nv)
-    return idx[np.lexsort((idx, -level))]
+    return idx[np.lexsort((idx, -level))], int(np.count_nonzero(level == L))
 
 
-def _round_sizes(n: int):
-    size, start = 16, 0
+def _round_sizes(n: int, first: int):
+    size, start = max(1, first), 0
     while start < n:
         b = min(n, start + size)
         yield start, b
@@ -333,10 +341,12 @@ class _Attractors:
         return apts, arad ** 2, alab
 
     def match(self, pts):
-        """Label of the known attractor with the same period and point set, or -1."""
+        """Label of the known attractor with the same set of section points (within match_tol)
+        whose period is the candidate's or divides it (a slowly converging orbit can pass the
+        periodicity test for a multiple of its period first), or -1."""
         q = len(pts)
         for k, a in enumerate(self.points):
-            if len(a) != q:
+            if q % len(a) != 0:
                 continue
             d = np.abs(pts[:, None, :] - a[None, :, :]).max(axis=2)
             if (d.min(axis=1) <= self.match_tol).all() and (d.min(axis=0) <= self.match_tol).all():
@@ -388,7 +398,7 @@ def basins(params: Params, *, x=(-3.0, 3.0), v=(-3.0, 3.0), grid=400, method: st
     xs = np.linspace(x_lo, x_hi, nx)
     vs = np.linspace(v_lo, v_hi, nv)
     n = nx * nv
-    order = _coarse_to_fine_order(nx, nv)
+    order, first = _coarse_to_fine_order(nx, nv)
     X0 = np.repeat(xs, nv)[order]
     V0 = np.tile(vs, nx)[order]
     pk = params.pack()
@@ -405,7 +415,7 @@ def basins(params: Params, *, x=(-3.0, 3.0), v=(-3.0, 3.0), grid=400, method: st
         old_chunk = nb.get_parallel_chunksize()
         nb.set_parallel_chunksize(8)
         try:
-            for a, b in _round_sizes(n):
+            for a, b in _round_sizes(n, first):
                 m = b - a
                 apts, arad2, alab = found.flat()
                 res = np.empty(m, np.int64)
@@ -424,9 +434,10 @@ def basins(params: Params, *, x=(-3.0, 3.0), v=(-3.0, 3.0), grid=400, method: st
                     pts = np.stack([cX[i, :q], cV[i, :q]], axis=1)
                     k = found.match(pts)
                     if k < 0:
-                        k = found.add(*_polish(solver, pk, pts, cxm[i], tol))
-                    else:
-                        found.max_x[k] = max(found.max_x[k], float(cxm[i]))
+                        pts, xm = _polish(solver, pk, pts, cxm[i], tol)
+                        k = found.match(pts)
+                        if k < 0:
+                            k = found.add(pts, xm)
                     res[i] = k
                 label[a:b] = res
                 if early_stop and len(found.points) > new_before:
@@ -462,9 +473,11 @@ def basins(params: Params, *, x=(-3.0, 3.0), v=(-3.0, 3.0), grid=400, method: st
 
 
 def _polish(solver, pk, pts, xmax, tol):
-    """A new attractor's section points and largest X, refined by following the orbit until
-    its section repeats to within tol / 1000 (at most _POLISH_MAX periods): the points found
-    when the periodicity test passed are only within ~tol / (1 - contraction) of the orbit."""
+    """A candidate attractor's section points, refined by following the orbit until its section
+    repeats to within tol / 1000 (at most _POLISH_MAX periods), then its period re-detected on
+    the refined points: the points found when the periodicity test passed are only within
+    ~tol / (1 - contraction) of the orbit, and a slowly converging orbit whose multiplier is
+    near -1 passes the test for 2q before it passes for q. Returns (points, max X)."""
     q = len(pts)
     state = np.empty(N_STATE)
     _init_state(state, pts[-1, 0], pts[-1, 1])
@@ -479,7 +492,10 @@ def _polish(solver, pk, pts, xmax, tol):
         change = max(abs(X[-1] - last[0]), abs(V[-1] - last[1]))
         last = np.array([X[-1], V[-1]])
         if change <= 1e-3 * tol:
-            return np.stack([X, V], axis=1), float(XM.max())
+            break
+    for d in range(1, q):
+        if q % d == 0 and (np.abs(X[d:] - X[:-d]) <= tol).all() and (np.abs(V[d:] - V[:-d]) <= tol).all():
+            return np.stack([X[:d], V[:d]], axis=1), float(XM[:d].max())
     return np.stack([X, V], axis=1), float(XM.max())
 
 

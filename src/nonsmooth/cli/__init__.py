@@ -12,6 +12,7 @@ from .app import app
 
 # Each command module registers its commands on ``app`` when imported.
 from . import simulate  # noqa: E402,F401
+from . import eta_study  # noqa: E402,F401
 from . import analyses  # noqa: E402,F401
 from . import reproduce  # noqa: E402,F401
 from . import basins  # noqa: E402,F401

@@ -30,10 +30,17 @@ Each mode segment is cut into pieces (at most ``THETA`` radians of the fastest o
 the mode; halved on demand, doubled after success). On every piece the switching functionals of
 the current phase and the extremum functional +-V are classified by ``pwlinear.classify``:
 excluded rigorously (derivative bounds from the closed form), certified single crossing
-(refined to round-off by ``pwlinear.refine_root``, time tolerance ``tol_t`` <= 1e-13 T), or
-undecided (the piece is halved). A grazing touch therefore cannot be missed and two crossings
-close together are separated. Xmax/Xmin include every interior extremum (zeros of V, located
-the same way, X evaluated there from the closed form).
+(refined by ``pwlinear.refine_root`` until the bracket or the estimated error is below
+``tol_t`` = 2e-14 max(1, T), i.e. <= 1.4e-13 s for the paper's periods), or undecided (the
+piece is halved). A grazing touch therefore cannot be missed and two crossings close together
+are separated. Xmax/Xmin include every interior extremum (zeros of V, located the same way,
+X evaluated there from the closed form).
+
+Cost: piece lengths are ``MC_LMAX / 2**l``, so their propagators (exp, cos, sin) are tabulated
+once per call and a piece costs a few dozen flops; only pieces cut at an output time and the
+root refinements (usually one or two evaluations) evaluate exp / cos / sin, with Taylor
+polynomials for the small angles. About 14 pieces and 4 refinements per forcing period on the
+chaotic ``table3`` case (omega = 0.92); see ``benchmarks/bench_exact.py``.
 
 Corner cases (all end with a status, never a hang)
 --------------------------------------------------
@@ -45,8 +52,11 @@ Corner cases (all end with a status, never a hang)
   F_s = 0 and F_s' > 0; everything else is free flight.
 * ``status.ZENO``: more than ``ZENO_MAX`` consecutive switches each less than
   ``ZENO_DT`` * T after the previous one (accumulation of ever shorter contacts, or a
-  numerically degenerate corner X = 1, V = 0, X'' = 0).
-* ``status.MAX_STEPS``: more than ``opts[OPT_MAX_STEPS]`` pieces per forcing period on average.
+  numerically degenerate corner X = 1, V = 0, X'' = 0 to round-off, where both switching
+  surfaces and the first derivatives of their functionals vanish together).
+* ``status.MAX_STEPS``: more than ``opts[OPT_MAX_STEPS]`` pieces per forcing period on average
+  (also seen at such a degenerate corner: the derivative bounds then allow only pieces of
+  about the time tolerance).
 * ``status.NON_FINITE``: non-finite input state or parameters giving non-finite values.
 * ``status.EVENT_FAILED``: an undamped mode forced exactly at its resonance (no bounded
   closed form), or a certified root that the refinement could not converge (not observed).
@@ -75,7 +85,7 @@ from .pwlinear import (CROSSING, MC_C, MC_K, MC_LMAX, N_BD, N_MC, UNDECIDED, acc
 FREE = 0  # mode code of free flight (Gamma-)
 CONTACT = 3  # mode code of contact (Gamma+)
 
-THETA = 1.0  # longest piece: THETA / max(sqrt(k), omega, c/2) in each mode
+THETA = 0.7  # longest piece: THETA / max(sqrt(k), omega, c/2) in each mode
 ZENO_MAX = 64
 ZENO_DT = 1e-9
 TOL_T = 2e-14
@@ -144,7 +154,7 @@ def advance_exact(p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
     TB = np.empty((2, N_LEV, 4))
     TL = np.empty((2, N_LEV))
     for m in range(2):
-        propagator_table(MC[m], om, N_LEV, TB[m])
+        propagator_table(MC, m, om, N_LEV, TB[m])
         for lev in range(N_LEV):
             TL[m, lev] = MC[m, MC_LMAX] * 0.5 ** lev
     BD = np.empty((2, 3, N_BD))
@@ -190,14 +200,13 @@ def advance_exact(p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
     t = 0.0
     C = 1.0
     S = 0.0
-    mc = MC[mi]
-    y, z = hom_part(mc, om, X, V, C, S)
-    A = accel(mc, om, y, z, C, S)
+    y, z = hom_part(MC, mi, om, X, V, C, S)
+    A = accel(MC, mi, om, y, z, C, S)
     lev = 0
     L = 0.0
     pieces = 0
     n_tiny = 0
-    t_switch = 0.0
+    t_switch = -1e300
     code = st.OK
     j = 0
     for it in range(n_total):
@@ -211,7 +220,6 @@ def advance_exact(p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
             if pieces > max_pieces:
                 code = st.MAX_STEPS
                 break
-            mc = MC[mi]
             nsw = sw_n[phase]
             # ---- immediate switch at the piece start (functional at 0 moving up) ----
             s_sw = -1.0
@@ -236,16 +244,16 @@ def advance_exact(p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
             if k_sw < 0:
                 rem = t_end - t
                 L = TL[mi, lev]
-                En = energy_norm(mc, y, z)
-                J0 = -mc[MC_K] * V - mc[MC_C] * A - F0 * om * S
+                En = energy_norm(MC, mi, y, z)
+                J0 = -MC[mi, MC_K] * V - MC[mi, MC_C] * A - F0 * om * S
                 if L >= rem:
                     last = True
                     L = rem
-                    X1, V1, A1, y1, z1, C1, S1 = eval_state(mc, om, y, z, C, S, L)
+                    X1, V1, A1, y1, z1, C1, S1 = eval_state(MC, mi, om, y, z, C, S, L)
                 else:
-                    tb = TB[mi, lev]
-                    X1, V1, A1, y1, z1, C1, S1 = apply_propagator(mc, om, y, z, C, S, tb[0], tb[1],
-                                                                  tb[2], tb[3])
+                    X1, V1, A1, y1, z1, C1, S1 = apply_propagator(
+                        MC, mi, om, y, z, C, S, TB[mi, lev, 0], TB[mi, lev, 1], TB[mi, lev, 2],
+                        TB[mi, lev, 3])
                 if not (math.isfinite(X1) and math.isfinite(V1)):
                     code = st.NON_FINITE
                     break
@@ -265,7 +273,7 @@ def advance_exact(p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
                     g1 = cx * X1 + cv * V1 + c0
                     d1 = cx * V1 + cv * A1
                     dd0 = cx * A + cv * J0
-                    M2, M3, M4 = deriv_bound(BD[mi, f], om, En)
+                    M2, M3, M4 = deriv_bound(BD, mi, f, om, En)
                     cl = classify(g0, d0, dd0, g1, d1, L, M2, M3, M4)
                     if cl == UNDECIDED:
                         if forced:
@@ -280,7 +288,7 @@ def advance_exact(p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
                         if undecided:
                             continue
                         sr, Xr, Vr, Ar, yr, zr, Cr, Sr, ok = refine_root(
-                            mc, om, F0, y, z, C, S, cx, cv, c0, g0, d0, g1, d1, L, tol_t)
+                            MC, mi, om, F0, y, z, C, S, cx, cv, c0, g0, d0, g1, d1, L, tol_t)
                         if not ok:
                             code = st.EVENT_FAILED
                             break
@@ -310,14 +318,15 @@ def advance_exact(p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
                     g1 = sv * V1
                     d1 = sv * A1
                     if Lx > 0.0:
-                        M2, M3, M4 = deriv_bound(BD[mi, _F_V], om, En)
+                        M2, M3, M4 = deriv_bound(BD, mi, _F_V, om, En)
                         cl = classify(g0, d0, sv * J0, g1, d1, Lx, M2, M3, M4)
                         if cl == UNDECIDED:
                             if Lx > tol_t:
                                 undecided = True
                         elif cl == CROSSING:
                             sr, Xr, Vr, Ar, yr, zr, Cr, Sr, ok = refine_root(
-                                mc, om, F0, y, z, C, S, 0.0, sv, 0.0, g0, d0, g1, d1, Lx, tol_t)
+                                MC, mi, om, F0, y, z, C, S, 0.0, sv, 0.0, g0, d0, g1, d1, Lx,
+                                tol_t)
                             if not ok:
                                 code = st.EVENT_FAILED
                                 break
@@ -369,9 +378,8 @@ def advance_exact(p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
                 mi = 1 if phase == _CONTACT else 0
                 mode = CONTACT if phase == _CONTACT else FREE
                 mask |= 1 << mode
-                mc = MC[mi]
-                y, z = hom_part(mc, om, X, V, C, S)
-                A = accel(mc, om, y, z, C, S)
+                y, z = hom_part(MC, mi, om, X, V, C, S)
+                A = accel(MC, mi, om, y, z, C, S)
                 lev = 0
         if code != st.OK:
             break
@@ -383,9 +391,8 @@ def advance_exact(p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
             S = 0.0
             if phase != _CONTACT:
                 phase = _ABOVE if (support and X > 1.0) else _BELOW
-            mc = MC[mi]
-            y, z = hom_part(mc, om, X, V, C, S)
-            A = accel(mc, om, y, z, C, S)
+            y, z = hom_part(MC, mi, om, X, V, C, S)
+            A = accel(MC, mi, om, y, z, C, S)
             lev = 0
         if it >= n_skip:
             k = it - n_skip
@@ -399,5 +406,5 @@ def advance_exact(p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
     state[ST_V] = V
     state[ST_VA] = V
     state[ST_MODE] = mode
-    state[ST_H] = pieces  # DEBUG
+    state[ST_H] = 0.0
     return code

@@ -156,39 +156,39 @@ def functional_bounds(mc, om, cx, cv, out):
 
 
 @nb.njit(cache=True, inline="always")
-def hom_part(mc, om, X, V, C, S):
+def hom_part(MC, m, om, X, V, C, S):
     """Homogeneous part (y, z) of the state (X, V) at forcing phase (C, S) = (cos, sin)."""
-    P = mc[MC_P]
-    Q = mc[MC_Q]
-    return X - mc[MC_XS] - P * C - Q * S, V - om * (Q * C - P * S)
+    P = MC[m, MC_P]
+    Q = MC[m, MC_Q]
+    return X - MC[m, MC_XS] - P * C - Q * S, V - om * (Q * C - P * S)
 
 
 @nb.njit(cache=True, inline="always")
-def accel(mc, om, y, z, C, S):
+def accel(MC, m, om, y, z, C, S):
     """X'' from the homogeneous part and the forcing phase."""
-    return -om * om * (mc[MC_P] * C + mc[MC_Q] * S) - mc[MC_K] * y - mc[MC_C] * z
+    return -om * om * (MC[m, MC_P] * C + MC[m, MC_Q] * S) - MC[m, MC_K] * y - MC[m, MC_C] * z
 
 
 @nb.njit(cache=True, inline="always")
-def jerk(mc, om, F0, V, A, S):
+def jerk(MC, m, om, F0, V, A, S):
     """X''' = -k V - c X'' - F0 om sin(om t)."""
-    return -mc[MC_K] * V - mc[MC_C] * A - F0 * om * S
+    return -MC[m, MC_K] * V - MC[m, MC_C] * A - F0 * om * S
 
 
 @nb.njit(cache=True, inline="always")
-def propagator(mc, om, s):
+def propagator(MC, m, om, s):
     """(eC, eS, cw, sw) of a step s: exp(A s) = eC I + eS (A - a I) and (cos, sin)(om s)."""
     cw, sw = cos_sin(om * s)
-    a = mc[MC_A]
-    kind = mc[MC_KIND]
+    a = MC[m, MC_A]
+    kind = MC[m, MC_KIND]
     if kind == KIND_UNDER:
-        nu = mc[MC_NU]
+        nu = MC[m, MC_NU]
         e = math.exp(a * s)
         cn, sn = cos_sin(nu * s)
         eC = e * cn
         eS = e * sn / nu
     elif kind == KIND_OVER:
-        mu = mc[MC_NU]
+        mu = MC[m, MC_NU]
         e1 = math.exp((a + mu) * s)
         eS = e1 * (-math.expm1(-2.0 * mu * s)) / (2.0 * mu)  # e^{as} sinh(mu s) / mu
         eC = e1 - mu * eS                                    # e^{as} cosh(mu s)
@@ -200,12 +200,12 @@ def propagator(mc, om, s):
 
 
 @nb.njit(cache=True)
-def propagator_table(mc, om, n_levels, out):
-    """``out[l] = propagator(mc, om, mc[MC_LMAX] / 2**l)`` for l < n_levels: the piece lengths
+def propagator_table(MC, m, om, n_levels, out):
+    """``out[l] = propagator(MC, m, om, MC[m, MC_LMAX] / 2**l)`` for l < n_levels: the lengths
     of the halving / doubling search, so that most pieces cost no transcendental function."""
-    Lm = mc[MC_LMAX]
+    Lm = MC[m, MC_LMAX]
     for lev in range(n_levels):
-        eC, eS, cw, sw = propagator(mc, om, Lm * 0.5 ** lev)
+        eC, eS, cw, sw = propagator(MC, m, om, Lm * 0.5 ** lev)
         out[lev, 0] = eC
         out[lev, 1] = eS
         out[lev, 2] = cw
@@ -213,46 +213,46 @@ def propagator_table(mc, om, n_levels, out):
 
 
 @nb.njit(cache=True, inline="always")
-def apply_propagator(mc, om, y0, z0, C0, S0, eC, eS, cw, sw):
+def apply_propagator(MC, m, om, y0, z0, C0, S0, eC, eS, cw, sw):
     """State after a step with a precomputed propagator: (X, V, A, y, z, C, S)."""
     C = C0 * cw - S0 * sw
     S = S0 * cw + C0 * sw
-    a = mc[MC_A]
-    k = mc[MC_K]
+    a = MC[m, MC_A]
+    k = MC[m, MC_K]
     y = (eC - a * eS) * y0 + eS * z0
     z = -k * eS * y0 + (eC + a * eS) * z0
-    P = mc[MC_P]
-    Q = mc[MC_Q]
+    P = MC[m, MC_P]
+    Q = MC[m, MC_Q]
     hp = P * C + Q * S
-    X = mc[MC_XS] + hp + y
+    X = MC[m, MC_XS] + hp + y
     V = om * (Q * C - P * S) + z
-    A = -om * om * hp - k * y - mc[MC_C] * z
+    A = -om * om * hp - k * y - MC[m, MC_C] * z
     return X, V, A, y, z, C, S
 
 
 @nb.njit(cache=True, inline="always")
-def eval_state(mc, om, y0, z0, C0, S0, s):
-    """State s after a point with homogeneous part (y0, z0) and phase (C0, S0), in mode ``mc``.
+def eval_state(MC, m, om, y0, z0, C0, S0, s):
+    """State s after a point with homogeneous part (y0, z0) and phase (C0, S0), in mode ``m`` (row m of the mode table MC).
 
     Returns (X, V, A, y, z, C, S) with A = X'' and (C, S) the forcing phase at the new time.
     """
-    eC, eS, cw, sw = propagator(mc, om, s)
-    return apply_propagator(mc, om, y0, z0, C0, S0, eC, eS, cw, sw)
+    eC, eS, cw, sw = propagator(MC, m, om, s)
+    return apply_propagator(MC, m, om, y0, z0, C0, S0, eC, eS, cw, sw)
 
 
 @nb.njit(cache=True, inline="always")
-def energy_norm(mc, y, z):
-    return math.sqrt(mc[MC_K] * y * y + z * z)
+def energy_norm(MC, m, y, z):
+    return math.sqrt(MC[m, MC_K] * y * y + z * z)
 
 
 @nb.njit(cache=True, inline="always")
-def deriv_bound(bd, om, En):
-    """(M2, M3, M4): bounds of |g''|, |g'''|, |g''''| over a piece whose start has energy
-    norm En."""
+def deriv_bound(BD, m, f, om, En):
+    """(M2, M3, M4): bounds of |g''|, |g'''|, |g''''| for functional f in mode m (table BD of
+    ``functional_bounds`` rows) over a piece whose start has energy norm En."""
     om2 = om * om
-    R = bd[BD_R]
-    return (bd[BD_D2] * En + om2 * R, bd[BD_D3] * En + om2 * om * R,
-            bd[BD_D4] * En + om2 * om2 * R)
+    R = BD[m, f, BD_R]
+    return (BD[m, f, BD_D2] * En + om2 * R, BD[m, f, BD_D3] * En + om2 * om * R,
+            BD[m, f, BD_D4] * En + om2 * om2 * R)
 
 
 @nb.njit(cache=True, inline="always")
@@ -403,7 +403,7 @@ def herm_root(g0, d0, g1, d1, L):
 
 
 @nb.njit(cache=True)
-def refine_root(mc, om, F0, y0, z0, C0, S0, cx, cv, c0, g0, d0, g1, d1, L, tol):
+def refine_root(MC, m, om, F0, y0, z0, C0, S0, cx, cv, c0, g0, d0, g1, d1, L, tol):
     """Root of g = cx X + cv V + c0 in [0, L] where g(0) = g0 <= 0 <= g(L) = g1 and g' > 0.
 
     Third-order Newton (root of the local quadratic g + g' d + g'' d^2 / 2) on the exact
@@ -416,13 +416,13 @@ def refine_root(mc, om, F0, y0, z0, C0, S0, cx, cv, c0, g0, d0, g1, d1, L, tol):
     lo = 0.0
     hi = L
     s = herm_root(g0, d0, g1, d1, L)
-    k = mc[MC_K]
-    c = mc[MC_C]
-    sqk = mc[MC_SQK]
+    k = MC[m, MC_K]
+    c = MC[m, MC_C]
+    sqk = MC[m, MC_SQK]
     X = V = A = y = z = C = S = 0.0
     ok = False
     for _ in range(100):
-        X, V, A, y, z, C, S = eval_state(mc, om, y0, z0, C0, S0, s)
+        X, V, A, y, z, C, S = eval_state(MC, m, om, y0, z0, C0, S0, s)
         J = -k * V - c * A - F0 * om * S
         J2 = -k * A - c * J - F0 * om * om * C
         g = cx * X + cv * V + c0
@@ -450,8 +450,8 @@ def refine_root(mc, om, F0, y0, z0, C0, S0, cx, cv, c0, g0, d0, g1, d1, L, tol):
                 V = V + A * delta + J * h2 + J2 * h3
                 cw, sw = cos_sin(om * delta)
                 C, S = C * cw - S * sw, S * cw + C * sw
-                y, z = hom_part(mc, om, X, V, C, S)
-                A = accel(mc, om, y, z, C, S)
+                y, z = hom_part(MC, m, om, X, V, C, S)
+                A = accel(MC, m, om, y, z, C, S)
                 s = sn
                 ok = True
                 break
