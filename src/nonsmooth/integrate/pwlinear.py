@@ -39,6 +39,8 @@ import math
 
 import numba as nb
 
+from .trig import cos_sin_small
+
 # ---- layout of a mode-coefficient row -------------------------------------------------------
 MC_K = 0       # stiffness k (> 0)
 MC_C = 1       # damping c (>= 0)
@@ -64,38 +66,8 @@ BD_D4 = 2  # dual norm of (cx, cv) A^4
 BD_R = 3   # amplitude of the harmonic part of g
 N_BD = 4
 
-# Taylor coefficients for cos/sin of small angles (|x| <= 0.5: error < 1e-16)
-_C2 = 1.0 / 2.0
-_C4 = 1.0 / 12.0
-_C6 = 1.0 / 30.0
-_C8 = 1.0 / 56.0
-_C10 = 1.0 / 90.0
-_C12 = 1.0 / 132.0
-_C14 = 1.0 / 182.0
-_C16 = 1.0 / 240.0
-_S3 = 1.0 / 6.0
-_S5 = 1.0 / 20.0
-_S7 = 1.0 / 42.0
-_S9 = 1.0 / 72.0
-_S11 = 1.0 / 110.0
-_S13 = 1.0 / 156.0
-_S15 = 1.0 / 210.0
-
 HERM_ERR = 1.0 / 384.0   # max |g - H| <= HERM_ERR L^4 max|g''''|   (cubic Hermite)
 HERM_DERR = 1.0 / 60.0   # max |g' - H'| <= sqrt(3)/216 L^3 max|g''''|, with a safety factor 2
-
-
-@nb.njit(cache=True, inline="always")
-def cos_sin(x):
-    """(cos x, sin x); Taylor polynomials for |x| <= 0.5, libm otherwise."""
-    if -0.5 <= x <= 0.5:
-        x2 = x * x
-        c = 1.0 - x2 * _C2 * (1.0 - x2 * _C4 * (1.0 - x2 * _C6 * (1.0 - x2 * _C8 * (
-            1.0 - x2 * _C10 * (1.0 - x2 * _C12 * (1.0 - x2 * _C14 * (1.0 - x2 * _C16)))))))
-        s = x * (1.0 - x2 * _S3 * (1.0 - x2 * _S5 * (1.0 - x2 * _S7 * (1.0 - x2 * _S9 * (
-            1.0 - x2 * _S11 * (1.0 - x2 * _S13 * (1.0 - x2 * _S15)))))))
-        return c, s
-    return math.cos(x), math.sin(x)
 
 
 @nb.njit(cache=True)
@@ -178,13 +150,13 @@ def jerk(MC, m, om, F0, V, A, S):
 @nb.njit(cache=True, inline="always")
 def propagator(MC, m, om, s):
     """(eC, eS, cw, sw) of a step s: exp(A s) = eC I + eS (A - a I) and (cos, sin)(om s)."""
-    cw, sw = cos_sin(om * s)
+    cw, sw = cos_sin_small(om * s)
     a = MC[m, MC_A]
     kind = MC[m, MC_KIND]
     if kind == KIND_UNDER:
         nu = MC[m, MC_NU]
         e = math.exp(a * s)
-        cn, sn = cos_sin(nu * s)
+        cn, sn = cos_sin_small(nu * s)
         eC = e * cn
         eS = e * sn / nu
     elif kind == KIND_OVER:
@@ -448,7 +420,7 @@ def refine_root(MC, m, om, F0, y0, z0, C0, S0, cx, cv, c0, g0, d0, g1, d1, L, to
                 h3 = h2 * delta / 3.0
                 X = X + V * delta + A * h2 + J * h3
                 V = V + A * delta + J * h2 + J2 * h3
-                cw, sw = cos_sin(om * delta)
+                cw, sw = cos_sin_small(om * delta)
                 C, S = C * cw - S * sw, S * cw + C * sw
                 y, z = hom_part(MC, m, om, X, V, C, S)
                 A = accel(MC, m, om, y, z, C, S)
@@ -467,5 +439,5 @@ def refine_root(MC, m, om, F0, y0, z0, C0, S0, cx, cv, c0, g0, d0, g1, d1, L, to
 
 __all__ = ["mode_coeffs", "functional_bounds", "eval_state", "hom_part", "accel", "jerk",
            "classify", "cubic_max", "refine_root", "herm_max", "herm_min_deriv", "herm_root", "energy_norm",
-           "deriv_bound", "cos_sin", "propagator", "propagator_table",
+           "deriv_bound", "cos_sin_small", "propagator", "propagator_table",
            "apply_propagator", "EXCLUDED", "CROSSING", "UNDECIDED", "N_MC", "N_BD"]

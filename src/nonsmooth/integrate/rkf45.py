@@ -37,6 +37,7 @@ from .. import status as st
 from ..models.switch import GAMMA_MINUS, SIGMA_ALPHA, accel, beta_ratio, inside_margin, region
 from .contract import OPT_ATOL, OPT_MAX_STEPS, OPT_RTOL, OPT_TRANSITION, ST_H, ST_MODE, ST_V, ST_VA, ST_X
 from .tableau import RKF45_A, RKF45_B5, RKF45_C, RKF45_E, RKF45_ORDER
+from .trig import cos_sin_small
 
 _A = RKF45_A
 _B = RKF45_B5
@@ -49,42 +50,6 @@ _SAFETY = 0.9
 _FM = {"contract", "reassoc"}  # let LLVM fuse and reassociate; NaN/inf semantics are kept
 _FAC_MIN = 0.2
 _FAC_MAX = 5.0
-
-# Taylor coefficients for cos/sin of small angles (|x| <= 0.5: error < 1e-16)
-_C2 = 1.0 / 2.0
-_C4 = 1.0 / 12.0
-_C6 = 1.0 / 30.0
-_C8 = 1.0 / 56.0
-_C10 = 1.0 / 90.0
-_C12 = 1.0 / 132.0
-_C14 = 1.0 / 182.0
-_C16 = 1.0 / 240.0
-_S3 = 1.0 / 6.0
-_S5 = 1.0 / 20.0
-_S7 = 1.0 / 42.0
-_S9 = 1.0 / 72.0
-_S11 = 1.0 / 110.0
-_S13 = 1.0 / 156.0
-_S15 = 1.0 / 210.0
-
-
-@nb.njit(cache=True, inline="always")
-def cos_sin_small(x):
-    """(cos x, sin x); Taylor series for |x| <= 0.5 (error < 1e-16), libm otherwise."""
-    if -0.1 <= x <= 0.1:
-        x2 = x * x
-        c = 1.0 - x2 * _C2 * (1.0 - x2 * _C4 * (1.0 - x2 * _C6 * (1.0 - x2 * _C8)))
-        s = x * (1.0 - x2 * _S3 * (1.0 - x2 * _S5 * (1.0 - x2 * _S7 * (1.0 - x2 * _S9))))
-        return c, s
-    if -0.5 <= x <= 0.5:
-        x2 = x * x
-        c = 1.0 - x2 * _C2 * (1.0 - x2 * _C4 * (1.0 - x2 * _C6 * (1.0 - x2 * _C8 * (
-            1.0 - x2 * _C10 * (1.0 - x2 * _C12 * (1.0 - x2 * _C14 * (1.0 - x2 * _C16)))))))
-        s = x * (1.0 - x2 * _S3 * (1.0 - x2 * _S5 * (1.0 - x2 * _S7 * (1.0 - x2 * _S9 * (
-            1.0 - x2 * _S11 * (1.0 - x2 * _S13 * (1.0 - x2 * _S15)))))))
-        return c, s
-    return math.cos(x), math.sin(x)
-
 
 # log2(m) on [0.5, 1), least-squares quartic (error 2e-4)
 _L4, _L3, _L2, _L1, _L0 = (-1.2665305831374971, 5.030988942552058, -8.324856642808804,
