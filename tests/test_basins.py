@@ -128,6 +128,21 @@ def test_exact_method_finds_the_same_attractors(fig7_110):
     assert ex.attrs["method"] == "exact"
 
 
+@pytest.mark.skipif(not exact_works(), reason="exact solver not available")
+def test_certified_lattice_cells_keep_labels_and_determinism():
+    """Grid >= 64: the lattice-cell lever is active; labels still equal full integration and do
+    not depend on the number of workers."""
+    p = fig7(1.18)
+    fast = basins(p, grid=64, method="exact", workers=2)
+    assert fast.attrs["certified_cells"] > 0
+    one = basins(p, grid=64, method="exact", workers=1)
+    np.testing.assert_array_equal(fast.label.values, one.label.values)
+    np.testing.assert_array_equal(fast.periods_used.values, one.periods_used.values)
+    slow = basins(p, grid=64, method="exact", early_stop=False)
+    np.testing.assert_array_equal(fast.label.values, slow.label.values)
+    assert fast.periods_used.mean() < 0.2 * slow.periods_used.mean()
+
+
 @pytest.mark.parametrize("kwargs, field", [
     (dict(x=(3, -3)), "x"),
     (dict(v=(1, 1)), "v"),

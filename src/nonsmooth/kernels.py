@@ -14,7 +14,7 @@ import numba as nb
 import numpy as np
 
 from .errors import ParameterError
-from .integrate.contract import N_OPTS, N_STATE, OPT_ATOL, OPT_MAX_STEPS, OPT_RTOL, OPT_TRANSITION
+from .integrate.contract import DISPATCH_SIGNATURE, N_OPTS, N_STATE, OPT_ATOL, OPT_MAX_STEPS, OPT_RTOL, OPT_TRANSITION
 from .integrate.exact import advance_exact
 from .integrate.rkf45 import advance_smooth
 from .models.switch import TRANSITIONS
@@ -24,7 +24,7 @@ METHOD_EXACT = 1
 METHODS = {"smooth": METHOD_SMOOTH, "exact": METHOD_EXACT}
 
 
-@nb.njit(cache=True)
+@nb.njit(DISPATCH_SIGNATURE, cache=True)
 def advance(method, p, opts, state, per_period, n_skip, n_out, X, V, R, M, Xmax, Xmin):
     """Run the kernel of ``method`` (see ``integrate.contract``); returns its status."""
     if method == METHOD_EXACT:

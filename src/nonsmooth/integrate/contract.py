@@ -30,3 +30,18 @@ ST_VA = 2  # entry velocity into Sigma_alpha (eq. 13a memory); unused by the exa
 ST_MODE = 3  # region/mode code; -1 = classify from (X, V) at the start
 ST_H = 4  # step size to try next (adaptive kernels); <= 0 = choose
 N_STATE = 5
+
+
+def _signatures():
+    from numba import types as t
+
+    f8 = t.float64[::1]
+    args = (f8, f8, f8, t.int64, t.int64, t.int64, f8, f8, t.int8[::1], t.uint8[::1], f8, f8)
+    return t.int64(*args), t.int64(t.int64, *args)
+
+
+#: Explicit numba signatures of a kernel and of the method dispatcher. Compiling the kernels
+#: for exactly these types means one machine-code version each: without them numba would
+#: compile (and cache) a new copy of every kernel for each combination of literal integers
+#: that a caller happens to pass.
+KERNEL_SIGNATURE, DISPATCH_SIGNATURE = _signatures()

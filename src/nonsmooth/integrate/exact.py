@@ -77,7 +77,7 @@ import numpy as np
 
 from .. import status as st
 from ..models.switch import beta_ratio
-from .contract import OPT_MAX_STEPS, ST_H, ST_MODE, ST_V, ST_VA, ST_X
+from .contract import KERNEL_SIGNATURE, OPT_MAX_STEPS, ST_H, ST_MODE, ST_V, ST_VA, ST_X
 from .pwlinear import (CROSSING, MC_C, MC_K, MC_LMAX, N_BD, N_MC, UNDECIDED, accel, apply_propagator,
                        classify, deriv_bound, energy_norm, eval_state, functional_bounds, hom_part,
                        mode_coeffs, propagator_table, refine_root)
@@ -120,7 +120,7 @@ def classify_initial(X, V, w0, ws, xi, xis, F0):
     return FREE
 
 
-@nb.njit(cache=True)
+@nb.njit(KERNEL_SIGNATURE, cache=True)
 def advance_exact(p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out, M_out,
                   Xmax_out, Xmin_out):
     """Kernel contract (see ``integrate.contract``) for the exact non-smooth model."""

@@ -35,7 +35,7 @@ import numpy as np
 
 from .. import status as st
 from ..models.switch import GAMMA_MINUS, SIGMA_ALPHA, accel, beta_ratio, inside_margin, region
-from .contract import OPT_ATOL, OPT_MAX_STEPS, OPT_RTOL, OPT_TRANSITION, ST_H, ST_MODE, ST_V, ST_VA, ST_X
+from .contract import KERNEL_SIGNATURE, OPT_ATOL, OPT_MAX_STEPS, OPT_RTOL, OPT_TRANSITION, ST_H, ST_MODE, ST_V, ST_VA, ST_X
 from .tableau import RKF45_A, RKF45_B5, RKF45_C, RKF45_E, RKF45_ORDER
 from .trig import cos_sin_small
 
@@ -158,7 +158,7 @@ def _rk_step(mode, X0, V0, A0, Va, C, S, h, om, F0, w02, ws2, xi, xis, eta, r, t
 assert tuple(_C * 8) == (0.0, 2.0, 3.0, 96.0 / 13.0, 8.0, 4.0)
 
 
-@nb.njit(cache=True, fastmath=_FM)
+@nb.njit(KERNEL_SIGNATURE, cache=True, fastmath=_FM)
 def advance_smooth(p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out, M_out,
                    Xmax_out, Xmin_out):
     """Kernel contract (see ``integrate.contract``) for the smoothed switch model, eqs. 10-14."""

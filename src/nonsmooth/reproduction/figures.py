@@ -14,7 +14,7 @@ import math
 import numpy as np
 
 from ..presets import preset
-from .core import (AGREES, DIFFERS, NOT_STATED, agree_if, figure, fmt, period_text,
+from .core import (DIFFERS, NOT_STATED, agree_if, figure, fmt, period_text,
                    verdict_period)
 
 # -- fixed choices where the paper is silent (quoted in the report) ---------------------------
