@@ -35,8 +35,8 @@ N_STATE = 5
 def _signatures():
     from numba import types as t
 
-    f8 = t.float64[::1]
-    args = (f8, f8, f8, t.int64, t.int64, t.int64, f8, f8, t.int8[::1], t.uint8[::1], f8, f8)
+    f8 = t.float64[:]  # any layout: the kernels touch these arrays once per call or interval
+    args = (f8, f8, f8, t.int64, t.int64, t.int64, f8, f8, t.int8[:], t.uint8[:], f8, f8)
     return t.int64(*args), t.int64(t.int64, *args)
 
 
