@@ -25,7 +25,6 @@ import argparse
 import math
 import time
 
-import numpy as np
 from scipy.integrate import solve_ivp
 
 from nonsmooth import Solver, preset

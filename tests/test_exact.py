@@ -21,7 +21,7 @@ from nonsmooth import Params, Solver, preset
 from nonsmooth import status as st
 from nonsmooth.integrate.contract import ST_MODE
 from nonsmooth.integrate.exact import advance_exact
-from nonsmooth.kernels import METHOD_EXACT, METHOD_SMOOTH, advance, new_state, output_buffers
+from nonsmooth.kernels import METHOD_EXACT, advance, new_state, output_buffers
 
 EXACT = Solver(method="exact")
 

@@ -36,7 +36,6 @@ import numpy as np
 import xarray as xr
 
 from ..errors import ParameterError
-from ..integrate.contract import ST_MODE
 from ..io import provenance_attrs
 from ..kernels import Solver, new_state
 from ..models.switch import GAMMA_PLUS, REGION_LEGEND

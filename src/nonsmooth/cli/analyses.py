@@ -11,7 +11,7 @@ from ..errors import ParameterError
 from .app import app
 from .common import (AtolOpt, MethodOpt, OutOpt, PlotOpt, PresetOpt, RtolOpt, SetOpt,
                      TransitionOpt, WorkersOpt, check_outputs, echo_written, load_params,
-                     require_output)
+                     require_output, save_outputs)
 
 FromOpt = Annotated[float, typer.Option("--from", help="first value of the range")]
 ToOpt = Annotated[float, typer.Option("--to", help="last value of the range")]
@@ -60,7 +60,6 @@ def poincare_cmd(
     """Stroboscopic Poincaré map (t = kT) with period and contact classification; plot like
     Figs. 10 and 12 (phase portrait with its section points, and the map)."""
     from ..analysis.poincare import poincare
-    from ..io import save_dataset, save_figure
     from ..simulate import check_int
 
     params = load_params(preset, set_)
@@ -70,12 +69,8 @@ def poincare_cmd(
     check_outputs(out, plot)
     ds = poincare(params, points=points, transient=transient, x0=x0, v0=v0, method=method,
                   rtol=rtol, atol=atol, transition=transition, orbit_samples=orbit_samples)
-    ds.attrs["preset"] = preset
-    if out is not None:
-        save_dataset(ds, out)
-    if plot is not None:
-        from ..plot.poincare import plot_poincare
-        save_figure(plot_poincare(ds), plot)
+    from ..plot.poincare import plot_poincare
+    save_outputs(ds, preset, out, plot, plot_poincare)
     a = ds.attrs
     kind = f"period {a['period']}" if a["period"] else "not periodic (period 0)"
     typer.echo(f"{preset}: {kind}, contact {a['contact']}, max X = {a['max_X']:.6g}, "
@@ -107,7 +102,6 @@ def bifurcation_cmd(
 ):
     """Bifurcation diagram of the section X(kT) over a parameter (Figs. 9 and 11)."""
     from ..analysis.bifurcation import SWEEPS, bifurcation_diagram
-    from ..io import save_dataset, save_figure
     from ..params import check_param_name
     from ..simulate import check_int
 
@@ -127,12 +121,8 @@ def bifurcation_cmd(
                                  record=record, method=method, x0=x0, v0=v0, rtol=rtol,
                                  atol=atol, transition=transition, settle=settle,
                                  workers=workers, progress=prog)
-    ds.attrs["preset"] = preset
-    if out is not None:
-        save_dataset(ds, out)
-    if plot is not None:
-        from ..plot.bifurcation import plot_bifurcation
-        save_figure(plot_bifurcation(ds), plot)
+    from ..plot.bifurcation import plot_bifurcation
+    save_outputs(ds, preset, out, plot, plot_bifurcation)
     per = ds.period.values
     typer.echo(f"{preset}: {param} {from_:g} ... {to:g}, {steps} values, sweep {sweep}: "
                f"{int((per == 0).sum())} non-periodic, {int((per > 0).sum())} periodic, "
@@ -164,7 +154,6 @@ def resonance_cmd(
     """Resonance curve (max X, min X versus omega, swept up and down with continuation) and
     the frequencies omega_a (contact starts), omega_b, omega_c (jumps), like Fig. 6."""
     from ..analysis.resonance import resonance_curve
-    from ..io import save_dataset, save_figure
     from ..simulate import check_int
 
     params = load_params(preset, set_)
@@ -180,12 +169,8 @@ def resonance_cmd(
                              x0=x0, v0=v0, rtol=rtol, atol=atol, transition=transition,
                              settle=settle, resolution=resolution, workers=workers,
                              progress=prog)
-    ds.attrs["preset"] = preset
-    if out is not None:
-        save_dataset(ds, out)
-    if plot is not None:
-        from ..plot.resonance import plot_resonance
-        save_figure(plot_resonance(ds), plot)
+    from ..plot.resonance import plot_resonance
+    save_outputs(ds, preset, out, plot, plot_resonance)
     a = ds.attrs
     typer.echo(f"{preset}: omega_a = {a['omega_a']:.5f} (contact starts), "
                f"omega_b = {a['omega_b']:.5f}, omega_c = {a['omega_c']:.5f} (jumps; NaN = none)")

@@ -8,8 +8,9 @@ from typing import Annotated, Optional
 import typer
 
 from .app import app
-from .common import (AtolOpt, MethodOpt, OutOpt, PlotOpt, PresetOpt, RtolOpt, SetOpt, TransitionOpt,
-                     WorkersOpt, check_outputs, echo_written, load_params, require_output)
+from .common import (AtolOpt, MethodOpt, OutOpt, PlotOpt, PresetOpt, RtolOpt, SetOpt,
+                     TransitionOpt, WorkersOpt, check_outputs, echo_written, load_params,
+                     require_output, save_outputs)
 
 
 @app.command("basins")
@@ -35,7 +36,7 @@ def basins_cmd(
     """Basins of attraction (attractors found automatically); a Fig. 7-style image and a Fig. 8-style
     figure of the coexisting periodic orbits."""
     from ..analysis.basins import basins
-    from ..io import check_writable, save_dataset, save_figure
+    from ..io import check_writable, save_figure
     from ..sweep import Progress
 
     params = load_params(preset, set_)
@@ -48,12 +49,8 @@ def basins_cmd(
                     max_periods=max_periods, max_period=max_period, rtol=rtol, atol=atol,
                     transition=transition, early_stop=not no_early_stop, workers=workers,
                     progress=bar)
-    ds.attrs["preset"] = preset
-    if out is not None:
-        save_dataset(ds, out)
-    if plot is not None:
-        from ..plot.basins import plot_basins
-        save_figure(plot_basins(ds), plot)
+    from ..plot.basins import plot_basins
+    save_outputs(ds, preset, out, plot, plot_basins)
     if orbits_plot is not None:
         from ..plot.basins import plot_attractors
         save_figure(plot_attractors(ds), orbits_plot)

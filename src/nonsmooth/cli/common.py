@@ -47,6 +47,18 @@ def require_output(out: Path | None, plot: Path | None) -> None:
         raise ParameterError("output: give -o FILE.nc and/or --plot FILE.png")
 
 
+def save_outputs(ds, preset: str, out: Path | None, plot: Path | None, figure=None) -> None:
+    """Record the preset, write the netCDF file and render ``figure(ds)`` (a plot function:
+    Dataset in, Figure out) to ``plot`` where asked."""
+    from ..io import save_dataset, save_figure
+
+    ds.attrs["preset"] = preset
+    if out is not None:
+        save_dataset(ds, out)
+    if plot is not None and figure is not None:
+        save_figure(figure(ds), plot)
+
+
 def echo_written(*paths) -> None:
     for p in paths:
         if p is not None:

@@ -9,7 +9,8 @@ import typer
 from ..errors import ParameterError
 from .app import app
 from .common import (AtolOpt, OutOpt, PlotOpt, PresetOpt, RtolOpt, SetOpt, TransitionOpt,
-                     WorkersOpt, check_outputs, echo_written, load_params, require_output)
+                     WorkersOpt, check_outputs, echo_written, load_params, require_output,
+                     save_outputs)
 
 
 def parse_etas(values) -> list[float]:
@@ -62,7 +63,6 @@ def eta_study_cmd(
     import math
 
     from ..analysis.eta_study import check_etas, eta_study
-    from ..io import save_dataset, save_figure
 
     etas = sorted(check_etas(parse_etas(list(eta or []) + list(more or []))), reverse=True)
     params = load_params(preset, set_)
@@ -72,12 +72,8 @@ def eta_study_cmd(
                    portrait_periods=portrait_periods, samples_per_period=samples_per_period,
                    x0=x0, v0=v0, rtol=rtol, atol=atol, distance_tol=distance_tol,
                    transition=transition, workers=workers)
-    ds.attrs["preset"] = preset
-    if out is not None:
-        save_dataset(ds, out)
-    if plot is not None:
-        from ..plot.eta_study import plot_eta_study
-        save_figure(plot_eta_study(ds), plot)
+    from ..plot.eta_study import plot_eta_study
+    save_outputs(ds, preset, out, plot, plot_eta_study)
     a = ds.attrs
     typer.echo(f"{preset}: exact model period {a['exact_period'] or 'none'}, "
                f"{'reaches' if a['exact_reaches_gamma_plus'] else 'never reaches'} Gamma+")

@@ -7,8 +7,9 @@ from typing import Annotated
 import typer
 
 from .app import app
-from .common import (AtolOpt, MethodOpt, OutOpt, PlotOpt, PresetOpt, RtolOpt, SetOpt, TransitionOpt,
-                     check_outputs, echo_written, load_params, require_output)
+from .common import (AtolOpt, MethodOpt, OutOpt, PlotOpt, PresetOpt, RtolOpt, SetOpt,
+                     TransitionOpt, check_outputs, echo_written, load_params, require_output,
+                     save_outputs)
 
 
 @app.command("simulate")
@@ -28,7 +29,6 @@ def simulate_cmd(
     plot: PlotOpt = None,
 ):
     """Integrate one trajectory; save X, V, region over time (netCDF) and a Fig. 3-style plot."""
-    from ..io import save_dataset, save_figure
     from ..simulate import simulate
 
     params = load_params(preset, set_)
@@ -36,12 +36,8 @@ def simulate_cmd(
     check_outputs(out, plot)
     ds = simulate(params, periods=periods, transient=transient, samples_per_period=samples_per_period,
                   x0=x0, v0=v0, method=method, rtol=rtol, atol=atol, transition=transition)
-    ds.attrs["preset"] = preset
-    if out is not None:
-        save_dataset(ds, out)
-    if plot is not None:
-        from ..plot.time_response import plot_time_response
-        save_figure(plot_time_response(ds), plot)
+    from ..plot.time_response import plot_time_response
+    save_outputs(ds, preset, out, plot, plot_time_response)
     visited = sorted(set(int(r) for r in ds.region.values))
     typer.echo(f"{preset}: {periods} periods after {transient}, max X = {float(ds.X.max()):.6g}, "
                f"regions visited {visited}")

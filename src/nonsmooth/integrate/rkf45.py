@@ -100,6 +100,24 @@ def _cubic(a0, a1, a2, a3, s):
     return a0 + s * (a1 + s * (a2 + s * a3))
 
 
+@nb.njit(cache=True, inline="always")
+def _x_extrema(X, V, X1, V1, h, xmax, xmin):
+    """(xmax, xmin) updated with the interior extrema of X on the step's cubic Hermite
+    interpolant (where V changes sign)."""
+    if V * V1 < 0.0:
+        dX = X1 - X
+        a1 = h * V
+        a2 = 3.0 * dX - 2.0 * h * V - h * V1
+        a3 = -2.0 * dX + h * V + h * V1
+        q1, q2 = _quad_roots01(a1, 2.0 * a2, 3.0 * a3)
+        for q in (q1, q2):
+            if q > 0.0:
+                xq = _cubic(X, a1, a2, a3, q)
+                xmax = max(xmax, xq)
+                xmin = min(xmin, xq)
+    return xmax, xmin
+
+
 @nb.njit(cache=True, inline="always", fastmath=_FM)
 def _rk_step(mode, X0, V0, A0, Va, C, S, h, om, F0, w02, ws2, xi, xis, eta, r, tr):
     """One RKF45 step with the field of ``mode`` held fixed.
@@ -310,29 +328,12 @@ def advance_smooth(p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_ou
                     new_mode = region(Xi, Vi, eta, r)
                 if new_mode == SIGMA_ALPHA and mode != SIGMA_ALPHA:
                     Va = V1
-                # extrema of X over the retaken step
-                if V * V1 < 0.0:
-                    dX = X1 - X
-                    a1 = hs * V
-                    a2 = 3.0 * dX - 2.0 * hs * V - hs * V1
-                    a3 = -2.0 * dX + hs * V + hs * V1
-                    q1, q2 = _quad_roots01(a1, 2.0 * a2, 3.0 * a3)
-                    for q in (q1, q2):
-                        if q > 0.0:
-                            xq = _cubic(X, a1, a2, a3, q)
-                            xmax = max(xmax, xq)
-                            xmin = min(xmin, xq)
+                xmax, xmin = _x_extrema(X, V, X1, V1, hs, xmax, xmin)  # over the retaken step
                 mode = new_mode
                 A1 = accel(mode, X1, V1, Va, F0 * C1, w02, ws2, xi, xis, eta, r, tr)
                 mask |= 1 << mode
             else:
-                if V * V1 < 0.0:
-                    q1, q2 = _quad_roots01(a1, 2.0 * a2, 3.0 * a3)
-                    for q in (q1, q2):
-                        if q > 0.0:
-                            xq = _cubic(X, a1, a2, a3, q)
-                            xmax = max(xmax, xq)
-                            xmin = min(xmin, xq)
+                xmax, xmin = _x_extrema(X, V, X1, V1, hs, xmax, xmin)
                 # step-size control after an accepted step
                 fac = _SAFETY * pow_fast(max(err2, 1e-30), -0.5 * _EXPO)
                 fac = min(_FAC_MAX, max(_FAC_MIN, fac))
