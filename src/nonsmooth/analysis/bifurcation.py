@@ -42,7 +42,16 @@ def _fix_mode(method, p, state):
             state[3] = -1.0
 
 
-@nb.njit(cache=True, parallel=True)
+_F3 = nb.float64[:, :, :]
+_I8_2 = nb.int64[:, :]
+#: one signature (any layout): chunks of the value axis are non-contiguous views, whole small
+#: sweeps are contiguous; without it numba would compile and cache both versions
+_CONTINUATION_SIG = nb.void(nb.int64, _F3, nb.float64[:], nb.float64[:, :], nb.float64[:], nb.int64,
+                            nb.float64, _F3, _F3, nb.int8[:, :, :], nb.uint8[:, :, :], _F3, _F3,
+                            _I8_2, _I8_2, _F3)
+
+
+@nb.njit(_CONTINUATION_SIG, cache=True, parallel=True)
 def continuation(method, P, opts, states, init, transient, settle_tol,
                  X, V, R, M, Xmax, Xmin, status, used, S):
     """For every branch b (in parallel) and parameter row i (in order): continue
