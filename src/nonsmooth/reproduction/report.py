@@ -49,8 +49,9 @@ def gaps(evidence: dict, quick: bool) -> list[tuple[str, str, list[str]]]:
         ("Fig. 7 colours and direction of the basin change",
          "The text calls the light basin 'without contact', then the non-impact attractor "
          "'dark' and the impact basin 'light'. We classify attractors by contact (max X >= 1 and "
-         "a visit to the contact regions), not by colour, and test the stated direction (contact "
-         "basin grows from 1.10 to 1.18).", ev("fig7")),
+         "a visit to the contact regions), not by colour; we read 'the light attractor increases "
+         "its size' with the paper's definition (light = no contact) and test the sentence about "
+         "omega_b and omega_c as written, against the resonance branches of Fig. 6a.", ev("fig7")),
         ("Tolerance and chaos criterion",
          "The paper gives rtol 1e-8 only; we use rtol = 1e-8, atol = 1e-10. 'Chaotic' is taken to "
          "mean that no period <= 64 repeats on the Poincaré section within 1e3 x the integration "
