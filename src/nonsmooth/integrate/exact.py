@@ -77,10 +77,28 @@ import numpy as np
 
 from .. import status as st
 from ..models.switch import beta_ratio
-from .contract import KERNEL_SIGNATURE, OPT_MAX_STEPS, ST_H, ST_MODE, ST_V, ST_VA, ST_X
-from .pwlinear import (CROSSING, MC_C, MC_K, MC_LMAX, N_BD, N_MC, UNDECIDED, accel, apply_propagator,
-                       classify, deriv_bound, energy_norm, eval_state, functional_bounds, hom_part,
-                       mode_coeffs, propagator_table, refine_root)
+from .contract import KERNEL_SIGNATURE, OPT_MAX_STEPS, ST_MODE, ST_V, ST_X
+from .pwlinear import (
+    CROSSING,
+    MC_C,
+    MC_K,
+    MC_LMAX,
+    N_BD,
+    N_MC,
+    UNDECIDED,
+    accel,
+    apply_propagator,
+    classify,
+    deriv_bound,
+    energy_norm,
+    eval_state,
+    functional_bounds,
+    hom_part,
+    mode_coeffs,
+    propagator_table,
+    refine_root,
+)
+from .record import record_interval, store_state
 
 FREE = 0  # mode code of free flight (Gamma-)
 CONTACT = 3  # mode code of contact (Gamma+)
@@ -394,17 +412,7 @@ def advance_exact(p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
             y, z = hom_part(MC, mi, om, X, V, C, S)
             A = accel(MC, mi, om, y, z, C, S)
             lev = 0
-        if it >= n_skip:
-            k = it - n_skip
-            X_out[k] = X
-            V_out[k] = V
-            R_out[k] = mode
-            M_out[k] = mask
-            Xmax_out[k] = xmax
-            Xmin_out[k] = xmin
-    state[ST_X] = X
-    state[ST_V] = V
-    state[ST_VA] = V
-    state[ST_MODE] = mode
-    state[ST_H] = 0.0
+        record_interval(it, n_skip, X, V, mode, mask, xmax, xmin, X_out, V_out, R_out, M_out,
+                        Xmax_out, Xmin_out)
+    store_state(state, X, V, V, mode, 0.0)
     return code

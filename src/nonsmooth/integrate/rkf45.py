@@ -34,8 +34,27 @@ import numba as nb
 import numpy as np
 
 from .. import status as st
-from ..models.switch import GAMMA_MINUS, SIGMA_ALPHA, accel, beta_ratio, inside_margin, region
-from .contract import KERNEL_SIGNATURE, OPT_ATOL, OPT_MAX_STEPS, OPT_RTOL, OPT_TRANSITION, ST_H, ST_MODE, ST_V, ST_VA, ST_X
+from ..models.switch import (
+    GAMMA_MINUS,
+    SIGMA_ALPHA,
+    accel,
+    beta_ratio,
+    inside_margin,
+    region,
+)
+from .contract import (
+    KERNEL_SIGNATURE,
+    OPT_ATOL,
+    OPT_MAX_STEPS,
+    OPT_RTOL,
+    OPT_TRANSITION,
+    ST_H,
+    ST_MODE,
+    ST_V,
+    ST_VA,
+    ST_X,
+)
+from .record import record_interval, store_state
 from .tableau import RKF45_A, RKF45_B5, RKF45_C, RKF45_E, RKF45_ORDER
 from .trig import cos_sin_small
 
@@ -358,19 +377,9 @@ def advance_smooth(p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_ou
             C = 1.0
             S = 0.0
             A = accel(mode, X, V, Va, F0, w02, ws2, xi, xis, eta, r, tr)
-        if it >= n_skip:
-            k = it - n_skip
-            X_out[k] = X
-            V_out[k] = V
-            R_out[k] = mode
-            M_out[k] = mask
-            Xmax_out[k] = xmax
-            Xmin_out[k] = xmin
-    state[ST_X] = X
-    state[ST_V] = V
-    state[ST_VA] = Va
-    state[ST_MODE] = mode
-    state[ST_H] = h
+        record_interval(it, n_skip, X, V, mode, mask, xmax, xmin, X_out, V_out, R_out, M_out,
+                        Xmax_out, Xmin_out)
+    store_state(state, X, V, Va, mode, h)
     return code
 
 
