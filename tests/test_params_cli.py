@@ -163,3 +163,8 @@ def test_presets_command_lists_every_preset():
     assert r.returncode == 0
     for name in ns.PRESETS:
         assert name in r.stdout
+
+
+def test_version_option():
+    r = _cli("--version")
+    assert r.returncode == 0 and r.stdout.strip() == f"nonsmooth {ns.__version__}"
