@@ -44,6 +44,16 @@ def check_params(params) -> Params:
     return params
 
 
+def start_trajectory(params, x0, v0, method, rtol, atol, transition):
+    """Validated single-trajectory set-up: (params, solver, packed params, kernel opts, initial
+    kernel state). Every error names its field."""
+    params = check_params(params)
+    x0 = check_float("x0", x0)
+    v0 = check_float("v0", v0)
+    solver = Solver(method=method, rtol=rtol, atol=atol, transition=transition)
+    return params, solver, params.pack(), solver.opts(), new_state(x0, v0)
+
+
 def simulate(params: Params, *, periods: int, transient: int = 0, samples_per_period: int = 100,
              x0: float = 0.0, v0: float = 0.0, method: str = "smooth", rtol: float = 1e-8,
              atol: float = 1e-10, transition: str = "eq13") -> xr.Dataset:
@@ -59,17 +69,12 @@ def simulate(params: Params, *, periods: int, transient: int = 0, samples_per_pe
     ``visited`` (bit mask of the regions visited since the previous sample, so that a pass
     through a thin band between two samples is not lost).
     """
-    params = check_params(params)
+    params, solver, p, opts, state = start_trajectory(params, x0, v0, method, rtol, atol,
+                                                      transition)
     periods = check_int("periods", periods, 1)
     transient = check_int("transient", transient, 0)
     spp = check_int("samples_per_period", samples_per_period, 1)
-    x0 = check_float("x0", x0)
-    v0 = check_float("v0", v0)
-    solver = Solver(method=method, rtol=rtol, atol=atol, transition=transition)
-
-    p = params.pack()
-    opts = solver.opts()
-    state = new_state(x0, v0)
+    x0, v0 = float(state[0]), float(state[1])
     empty = output_buffers(0)
     code = advance(solver.code, p, opts, state, 1, transient, 0, *empty)
     if code != st.OK:

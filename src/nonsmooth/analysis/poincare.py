@@ -44,7 +44,7 @@ from .. import status as st
 from ..errors import IntegrationError
 from ..integrate.contract import ST_MODE
 from ..io import provenance_attrs
-from ..kernels import Solver, advance, new_state, output_buffers
+from ..kernels import Solver, advance, output_buffers
 from ..models.switch import REGION_LEGEND
 from ..params import Params
 from .periodicity import detect_period, section_tolerance
@@ -182,19 +182,15 @@ def poincare(params: Params, *, points: int, transient: int, x0: float = 0.0, v0
 
     Raises IntegrationError if the trajectory fails (sweeps record failures instead).
     """
-    from ..simulate import check_float, check_int, check_params
-    params = check_params(params)
+    from ..simulate import check_int, start_trajectory
+    params, solver, p, opts, state = start_trajectory(params, x0, v0, method, rtol, atol,
+                                                      transition)
+    x0, v0 = float(state[0]), float(state[1])
     points = check_int("points", points, 1)
     transient = check_int("transient", transient, 0)
     orbit_samples = check_int("orbit_samples", orbit_samples, 1)
     if orbit_periods is not None:
         orbit_periods = check_int("orbit_periods", orbit_periods, 1)
-    x0 = check_float("x0", x0)
-    v0 = check_float("v0", v0)
-    solver = Solver(method=method, rtol=rtol, atol=atol, transition=transition)
-    p = params.pack()
-    opts = solver.opts()
-    state = new_state(x0, v0)
     X, V, R, M, Xmax, Xmin = output_buffers(points)
     code, used = settle_and_record(solver.code, p, opts, state, transient,
                                    settle_tolerance(solver, settle), X, V, R, M, Xmax, Xmin)

@@ -39,6 +39,7 @@ import math
 
 import numba as nb
 
+from .roots import quad_roots01
 from .trig import cos_sin_small
 
 # ---- layout of a mode-coefficient row -------------------------------------------------------
@@ -271,29 +272,9 @@ def herm_max(g0, d0, g1, d1, L):
         best = g1
         arg = L
     # H'(u) = a1 + 2 a2 u + 3 a3 u^2
-    qa = 3.0 * a3
-    qb = 2.0 * a2
-    qc = a1
-    if qa == 0.0:
-        if qb != 0.0:
-            u = -qc / qb
-            if 0.0 < u < 1.0:
-                h = g0 + u * (a1 + u * (a2 + u * a3))
-                if h > best:
-                    best = h
-                    arg = u * L
-        return best, arg
-    disc = qb * qb - 4.0 * qa * qc
-    if disc < 0.0:
-        return best, arg
-    sq = math.sqrt(disc)
-    q = -0.5 * (qb + sq) if qb >= 0.0 else -0.5 * (qb - sq)
-    for i in range(2):
-        if i == 0:
-            u = q / qa
-        else:
-            u = qc / q if q != 0.0 else -1.0
-        if 0.0 < u < 1.0:
+    u1, u2 = quad_roots01(a1, 2.0 * a2, 3.0 * a3)
+    for u in (u1, u2):
+        if u > 0.0:
             h = g0 + u * (a1 + u * (a2 + u * a3))
             if h > best:
                 best = h

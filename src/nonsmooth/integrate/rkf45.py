@@ -56,6 +56,7 @@ from .contract import (
 )
 from .record import record_interval, store_state
 from .tableau import RKF45_A, RKF45_B5, RKF45_C, RKF45_E, RKF45_ORDER
+from .roots import quad_roots01
 from .trig import cos_sin_small
 
 _A = RKF45_A
@@ -89,32 +90,6 @@ def pow_fast(x, a):
 
 
 @nb.njit(cache=True, inline="always")
-def _quad_roots01(c0, c1, c2):
-    """Roots of c0 + c1 s + c2 s^2 in the open interval (0, 1); -1.0 where there is none."""
-    r1 = -1.0
-    r2 = -1.0
-    if c2 == 0.0:
-        if c1 != 0.0:
-            s = -c0 / c1
-            if 0.0 < s < 1.0:
-                r1 = s
-        return r1, r2
-    disc = c1 * c1 - 4.0 * c2 * c0
-    if disc < 0.0:
-        return r1, r2
-    sq = math.sqrt(disc)
-    q = -0.5 * (c1 + sq) if c1 >= 0.0 else -0.5 * (c1 - sq)
-    if q != 0.0:
-        s = q / c2
-        if 0.0 < s < 1.0:
-            r1 = s
-        s = c0 / q
-        if 0.0 < s < 1.0:
-            r2 = s
-    return r1, r2
-
-
-@nb.njit(cache=True, inline="always")
 def _cubic(a0, a1, a2, a3, s):
     return a0 + s * (a1 + s * (a2 + s * a3))
 
@@ -128,7 +103,7 @@ def _x_extrema(X, V, X1, V1, h, xmax, xmin):
         a1 = h * V
         a2 = 3.0 * dX - 2.0 * h * V - h * V1
         a3 = -2.0 * dX + h * V + h * V1
-        q1, q2 = _quad_roots01(a1, 2.0 * a2, 3.0 * a3)
+        q1, q2 = quad_roots01(a1, 2.0 * a2, 3.0 * a3)
         for q in (q1, q2):
             if q > 0.0:
                 xq = _cubic(X, a1, a2, a3, q)
@@ -291,11 +266,11 @@ def advance_smooth(p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_ou
             if check:
                 for which in range(3):
                     if which == 0:  # extrema of h_alpha = X - 1
-                        q1, q2 = _quad_roots01(a1, 2.0 * a2, 3.0 * a3)
+                        q1, q2 = quad_roots01(a1, 2.0 * a2, 3.0 * a3)
                     elif which == 1:  # extrema of V (h_alpha + h_beta = -r V)
-                        q1, q2 = _quad_roots01(b1, 2.0 * b2, 3.0 * b3)
+                        q1, q2 = quad_roots01(b1, 2.0 * b2, 3.0 * b3)
                     else:  # extrema of h_beta = -(X - 1) - r V
-                        q1, q2 = _quad_roots01(-a1 - r * b1, -2.0 * (a2 + r * b2),
+                        q1, q2 = quad_roots01(-a1 - r * b1, -2.0 * (a2 + r * b2),
                                                -3.0 * (a3 + r * b3))
                     for q in (q1, q2):
                         if 0.0 < q < s_ev:
