@@ -3,11 +3,7 @@
 Public API: :class:`Params`, :func:`preset`, :func:`simulate`, and the analyses.
 """
 
-from ._numba_cache import configure as _configure_numba_cache
-
-_configure_numba_cache()  # before any compiled module is imported
-
-from ._version import __version__  # noqa: E402
+from ._version import __version__
 from .errors import IntegrationError, NonsmoothError, OutputError, ParameterError
 from .kernels import Solver
 from .params import PARAM_NAMES, Params

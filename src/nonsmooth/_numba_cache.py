@@ -1,9 +1,16 @@
-"""Point numba's on-disk cache at a directory keyed by a hash of this package's source.
+"""Numba's on-disk cache for this package's kernels, invalidated by the kernels' own sources.
 
 Numba keys a cached function on the file that defines it, not on the compiled functions it
 calls: after an edit to a kernel, a cached caller (the method dispatcher, a sweep) would keep
-running the old kernel. Keying the whole cache directory on the package source makes that
-impossible. A ``NUMBA_CACHE_DIR`` set by the user is respected.
+running the old kernel. This module registers a cache *locator* that applies only to functions
+defined in this package's compiled modules (``KERNEL_SOURCES``): their cache entries are stamped
+with a digest of all those sources, so an edit to any of them invalidates every cached kernel,
+and an edit elsewhere (a plot label, the CLI, the reproduction report) invalidates nothing.
+
+Nothing else in the process is affected: other numba libraries keep numba's own locators and
+``numba.config.CACHE_DIR``. The cache lives in ``$NUMBA_CACHE_DIR/nonsmooth`` when the user set
+that variable, else in ``$XDG_CACHE_HOME/nonsmooth/numba`` (``~/.cache``), else in the temporary
+directory; where none is writable numba's own locators decide (in-tree ``__pycache__``).
 """
 
 from __future__ import annotations
@@ -13,46 +20,141 @@ import os
 import tempfile
 from pathlib import Path
 
+ROOT = Path(__file__).resolve().parent
+
+#: Sources whose compiled code (or constants read by compiled code) the kernels depend on:
+#: every package module with numba code must be listed here (a test checks it).
+KERNEL_SOURCES = ("integrate", "models", "analysis", "kernels.py", "sweep.py", "status.py",
+                  "params.py")
+
+_digest: str | None = None
+_base: Path | None = None
+
+
+def kernel_source_files() -> list[Path]:
+    files = []
+    for entry in KERNEL_SOURCES:
+        path = ROOT / entry
+        files.extend(sorted(path.rglob("*.py")) if path.is_dir() else [path])
+    return files
+
 
 def source_digest() -> str:
-    h = hashlib.sha256()
-    root = Path(__file__).parent
-    for path in sorted(root.rglob("*.py")):
-        h.update(str(path.relative_to(root)).encode())
-        h.update(path.read_bytes())
-    return h.hexdigest()[:16]
+    """sha256 (16 hex digits) of the kernel sources' paths and contents (computed once)."""
+    global _digest
+    if _digest is None:
+        h = hashlib.sha256()
+        for path in kernel_source_files():
+            h.update(str(path.relative_to(ROOT)).encode())
+            h.update(path.read_bytes())
+        _digest = h.hexdigest()[:16]
+    return _digest
 
 
-def configure() -> str | None:
-    if os.environ.get("NUMBA_CACHE_DIR"):
-        return None
-    import numba
+def cache_base() -> Path | None:
+    """The first writable cache directory (see module docstring), or None."""
+    global _base
+    if _base is None:
+        candidates = []
+        if os.environ.get("NUMBA_CACHE_DIR"):
+            candidates.append(Path(os.environ["NUMBA_CACHE_DIR"]) / "nonsmooth")
+        home = os.environ.get("XDG_CACHE_HOME") or str(Path.home() / ".cache")
+        candidates += [Path(home) / "nonsmooth" / "numba",
+                       Path(tempfile.gettempdir()) / "nonsmooth-cache" / "numba"]
+        for d in candidates:
+            try:
+                d.mkdir(parents=True, exist_ok=True)
+                tempfile.TemporaryFile(dir=d).close()
+            except OSError:
+                continue
+            _base = d
+            break
+    return _base
 
-    base = Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache") / "nonsmooth"
-    digest = source_digest()
-    for parent in (base, Path(tempfile.gettempdir()) / "nonsmooth-cache"):
-        d = parent / f"numba-{digest}"
-        try:
-            d.mkdir(parents=True, exist_ok=True)
-            probe = d / ".write-test"
-            probe.touch()
-            probe.unlink()
-        except OSError:
-            continue
-        numba.config.CACHE_DIR = str(d)
-        _prune(parent, keep=d)
-        return str(d)
-    return None
 
-
-def _prune(parent: Path, keep: Path, n_keep: int = 4) -> None:
-    """Remove all but the ``n_keep`` most recently used cache directories of older sources."""
-    import shutil
-
+def is_compiled(module: str) -> bool:
+    """True if ``nonsmooth.<module>`` (dotted, e.g. "integrate.rkf45") has cache entries for
+    today's kernel sources: used to tell the user once that a first run compiles."""
+    base = cache_base()
+    if base is None:
+        return False
+    path = ROOT.joinpath(*module.split(".")).with_suffix(".py")
+    sub = base / _subpath(path)
+    stem = path.stem
     try:
-        dirs = sorted((p for p in parent.glob("numba-*") if p.is_dir() and p != keep),
-                      key=lambda p: p.stat().st_mtime, reverse=True)
-        for old in dirs[n_keep - 1:]:
-            shutil.rmtree(old, ignore_errors=True)
+        return any(_index_is_current(p) for p in sub.glob(f"{stem}.*.nbi"))
     except OSError:
-        pass
+        return False
+
+
+def _index_is_current(index: Path) -> bool:
+    # the index starts with the pickled source stamp; a stale one names another digest
+    try:
+        return source_digest().encode() in index.read_bytes()[:256]
+    except OSError:
+        return False
+
+
+def _subpath(py_file: Path) -> str:
+    rel = py_file.resolve().parent.relative_to(ROOT)
+    return "_".join(("nonsmooth",) + rel.parts) + "_" + hashlib.sha1(
+        str(py_file.resolve().parent).encode()).hexdigest()[:12]
+
+
+def _locator_class():
+    from numba.core import caching
+
+    class KernelCacheLocator(caching._CacheLocator):
+        """Cache locator for this package's kernels (see module docstring)."""
+
+        def __init__(self, py_func, py_file):
+            self._py_file = py_file
+            self._lineno = py_func.__code__.co_firstlineno
+            self._cache_path = str(cache_base() / _subpath(Path(py_file)))
+
+        def get_cache_path(self):
+            return self._cache_path
+
+        def get_source_stamp(self):
+            return "nonsmooth-kernels-" + source_digest()
+
+        def get_disambiguator(self):
+            return str(self._lineno)
+
+        @classmethod
+        def from_function(cls, py_func, py_file):
+            try:
+                path = Path(py_file).resolve()
+            except (OSError, TypeError):
+                return None
+            if cache_base() is None or path not in _kernel_set():
+                return None
+            self = cls(py_func, py_file)
+            try:
+                self.ensure_cache_path()
+            except OSError:
+                return None
+            return self
+
+    return KernelCacheLocator
+
+
+_kernel_files: frozenset | None = None
+
+
+def _kernel_set() -> frozenset:
+    global _kernel_files
+    if _kernel_files is None:
+        _kernel_files = frozenset(p.resolve() for p in kernel_source_files())
+    return _kernel_files
+
+
+def configure() -> None:
+    """Register the locator (idempotent). Imports numba's caching module, nothing heavier."""
+    from numba.core import caching
+
+    impl = getattr(caching, "CacheImpl", None) or getattr(caching, "_CacheImpl")
+    classes = impl._locator_classes
+    if any(getattr(c, "__name__", "") == "KernelCacheLocator" for c in classes):
+        return
+    classes.insert(0, _locator_class())

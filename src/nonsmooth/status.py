@@ -16,6 +16,16 @@ MESSAGES = {
     EVENT_FAILED: "event location failed",
 }
 
+#: One word per status for CF ``flag_meanings``.
+FLAG_NAMES = {
+    OK: "ok",
+    MAX_STEPS: "too_many_steps",
+    STEP_TOO_SMALL: "step_size_too_small",
+    NON_FINITE: "non_finite_state",
+    ZENO: "zeno_accumulation",
+    EVENT_FAILED: "event_location_failed",
+}
+
 
 def message(code: int) -> str:
     return MESSAGES.get(int(code), f"unknown status {int(code)}")
