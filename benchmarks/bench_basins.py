@@ -8,6 +8,8 @@ spacing); the load average is printed before and after each run.
 Run:  python benchmarks/bench_basins.py [--method smooth|exact|both] [--omega 1.10]
                                         [--grids 200 1000] [--workers N]
 Throughput: trajectory-periods per second = (sum of periods_used + certification periods) / time.
+The last line is the total timed seconds (for ``../shared/tools/side-by-side``), e.g.
+``../shared/tools/side-by-side 8d0d1d5 benchmarks/bench_basins.py --method exact --grids 200``.
 """
 
 import argparse
@@ -35,7 +37,7 @@ def run(params, method, grid, workers):
                    for k in range(ds.sizes["attractor"]))
     print(f"{method:6s} {grid:5d}^2: {dt:8.2f} s  {work / dt:10.0f} trajectory-periods/s  "
           f"mean {ds.attrs['mean_periods_used']:.2f} periods/point  {l0} -> {load()}  "
-          f"undecided {ds.attrs['undecided_fraction']:.4f}  {fr}", flush=True)
+          f"undecided {float((ds.label.values < 0).mean()):.4f}  {fr}", flush=True)
     return dt
 
 
@@ -51,17 +53,20 @@ def main():
     targets = {"exact": 20.0, "smooth": 120.0}
     print(f"fig7, omega={a.omega}, [-3, 3]^2, cpus={os.cpu_count()}, "
           f"threads={a.workers or numba.config.NUMBA_NUM_THREADS}, {load()}")
+    total = 0.0
     for m in methods:
         basins(params, grid=4, method=m, workers=a.workers)  # compilation / cache load
         times = {}
         for g in a.grids:
             times[g] = run(params, m, g, a.workers)
+            total += times[g]
         g0 = min(times)
         est = times[g0] * (1000 / g0) ** 2
         line = f"{m}: 1000^2 extrapolated from {g0}^2: {est:.1f} s"
         if 1000 in times:
             line += f"; measured {times[1000]:.1f} s"
         print(f"{line} (target {targets[m]:.0f} s)")
+    print(f"timed total (s): {total:.3f}")
 
 
 if __name__ == "__main__":

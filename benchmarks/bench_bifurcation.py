@@ -2,6 +2,7 @@
 200 recorded) periods, both sweeps (up and down in parallel), smoothed model.
 
 Run: python benchmarks/bench_bifurcation.py [--values 1000] [--workers N] [--no-settle]
+The last line printed is the wall time in seconds.
 Throughput is reported in nominal trajectory-periods (values x sweeps x (transient + record))
 per second and in periods actually integrated (the settled transient ends early).
 """
@@ -25,7 +26,12 @@ def main():
     ap.add_argument("--sweep", default="both")
     ap.add_argument("--method", default="smooth")
     ap.add_argument("--no-settle", action="store_true")
+    ap.add_argument("--no-extend", action="store_true",
+                    help="no extension of still-converging sections (isolates the sweep itself)")
     a = ap.parse_args()
+    if a.no_extend:
+        import nonsmooth.analysis.bifurcation as bif
+        bif.MAX_ROUNDS = 0  # absent before the extension existed: then a no-op
     params = preset("table3")
     values = np.linspace(0.8, 1.0, a.values)
     # warm-up (compilation / cache load)
@@ -51,6 +57,7 @@ def main():
     print(f"CPU time {cpu:.2f} s (all threads): {actual / cpu:,.0f} periods per CPU-second; "
           f"on {os.cpu_count()} idle cores expect about {cpu / min(nsw, os.cpu_count()):.1f} s wall")
     print(f"failed points: {ds.attrs['n_failed']}; loadavg before {load0[0]:.2f}, after {load1[0]:.2f}")
+    print(f"{dt:.4f}")  # last line: seconds (for ../shared/tools/side-by-side)
 
 
 if __name__ == "__main__":

@@ -9,12 +9,13 @@ import nonsmooth as ns
 from nonsmooth.analysis.bifurcation import bifurcation_diagram
 from nonsmooth.analysis.poincare import poincare
 from nonsmooth.analysis.resonance import resonance_curve
+from nonsmooth.plot.bifurcation import sweep_names
 from oracles import steady_amplitude
 
 
 def _exact_available():
     try:
-        poincare(ns.preset("fig6a").replace(F0=0.01), points=2, transient=1, method="exact")
+        poincare(ns.preset("fig6a").replace(F0=0.01), record=2, transient=1, method="exact")
         return True
     except ns.IntegrationError:
         return False
@@ -31,13 +32,13 @@ def test_linear_stroboscopic_fixed_point(method):
     A = steady_amplitude(p.omega0, p.xi, p.F0, p.omega)
     phi = math.atan2(p.xi * p.omega, p.omega0**2 - p.omega**2)
     assert A < 0.2
-    ds = poincare(p, points=8, transient=150, method=method)
+    ds = poincare(p, record=8, transient=150, method=method)
     np.testing.assert_allclose(ds.X.values, A * math.cos(phi), atol=1e-7)
     np.testing.assert_allclose(ds.V.values, A * p.omega * math.sin(phi), atol=1e-7)
-    assert ds.attrs["period"] == 1
-    assert ds.attrs["contact"] == 0
-    assert ds.attrs["max_X"] == pytest.approx(A, abs=1e-6)
-    assert ds.attrs["min_X"] == pytest.approx(-A, abs=1e-6)
+    assert ds["period"] == 1
+    assert ds["contact"] == 0
+    assert ds["max_X"] == pytest.approx(A, abs=1e-6)
+    assert ds["min_X"] == pytest.approx(-A, abs=1e-6)
     # the orbit run covers one period and starts/ends on the section point
     assert ds.orbit_X.values[0] == pytest.approx(ds.X.values[-1], abs=1e-12)
     assert ds.orbit_X.values[-1] == pytest.approx(ds.X.values[0], abs=1e-7)
@@ -52,18 +53,18 @@ def test_linear_stroboscopic_fixed_point(method):
     ("table4", dict(F0=0.35), 0),      # paper Fig. 12b: chaotic
 ])
 def test_known_periods(name, change, period):
-    ds = poincare(ns.preset(name).replace(**change), points=300, transient=600, settle=True)
-    assert ds.attrs["period"] == period
-    assert ds.attrs["contact"] == (0 if change.get("omega") == 0.80 else 1)
-    assert (ds.attrs["max_X"] >= 1.0) == bool(ds.attrs["contact"])
+    ds = poincare(ns.preset(name).replace(**change), record=300, transient=600, settle=True)
+    assert ds["period"] == period
+    assert ds["contact"] == (0 if change.get("omega") == 0.80 else 1)
+    assert (ds["max_X"] >= 1.0) == bool(ds["contact"])
 
 
 def test_settle_changes_section_by_far_less_than_the_period_tolerance():
     p = ns.preset("table3").replace(omega=0.91)
-    a = poincare(p, points=30, transient=800)
-    b = poincare(p, points=30, transient=800, settle=True)
-    used = b.attrs["transient_used"]
-    assert used < 400 and a.attrs["period"] == b.attrs["period"] == 3
+    a = poincare(p, record=30, transient=800)
+    b = poincare(p, record=30, transient=800, settle=True)
+    used = b["transient_used"]
+    assert used < 400 and a["period"] == b["period"] == 3
     # the early stop shifts the phase of the period-3 sequence by (800 - used) mod 3
     err = min(float(np.abs(a.X.values[3:-3] - np.roll(b.X.values, s)[3:-3]).max())
               for s in range(3))
@@ -113,11 +114,11 @@ def test_bifurcation_agrees_with_poincare():
     up = bifurcation_diagram(p, "omega", vals, sweep="up", transient=300, record=30,
                              settle=False)
     for i, v in enumerate(vals):
-        ref = poincare(p.replace(omega=v), points=30, transient=300)
+        ref = poincare(p.replace(omega=v), record=30, transient=300)
         np.testing.assert_array_equal(fresh.X.values[0, i], ref.X.values)
         np.testing.assert_array_equal(fresh.V.values[0, i], ref.V.values)
-        assert fresh.period.values[0, i] == ref.attrs["period"]
-        assert fresh.max_X.values[0, i] == ref.attrs["max_X"]
+        assert fresh.period.values[0, i] == ref["period"]
+        assert fresh.max_X.values[0, i] == ref["max_X"]
     # the first value of the up sweep starts from (x0, v0) like poincare
     np.testing.assert_array_equal(up.X.values[0, 0], fresh.X.values[0, 0])
     assert up.period.values[0, 1] == 3
@@ -139,14 +140,15 @@ def test_bifurcation_identical_for_1_and_2_workers():
 def test_bifurcation_dataset_layout_and_hysteresis_order(tmp_path):
     p = ns.preset("table4")
     ds = bifurcation_diagram(p, "F0", [0.2, 0.3, 0.4], sweep="both", transient=100, record=8)
-    assert list(ds.sweep.values) == ["up", "down"]
+    assert sweep_names(ds) == ["up", "down"]
     assert ds.X.dims == ("sweep", "F0", "n") and ds.X.shape == (2, 3, 8)
     assert ds.attrs["swept_param"] == "F0" and ds.attrs["param"] == "F0"
+    assert "param_F0" not in ds.attrs  # swept: a coordinate, not one value
     assert np.all(ds.status.values == 0)
     path = ns.io.save_dataset(ds, tmp_path / "b.nc")
     back = ns.io.load_dataset(path)
     np.testing.assert_array_equal(back.X.values, ds.X.values)
-    assert list(back.sweep.values) == ["up", "down"]
+    assert sweep_names(back) == ["up", "down"]
 
 
 def test_failed_point_is_marked_and_the_rest_completes():
@@ -182,7 +184,7 @@ def test_plots_return_figures():
     from nonsmooth.plot.resonance import plot_resonance
     import matplotlib.pyplot as plt
     p = ns.preset("table3").replace(omega=0.91)
-    f = plot_poincare(poincare(p, points=20, transient=50, orbit_samples=20))
+    f = plot_poincare(poincare(p, record=20, transient=50, orbit_samples=20))
     assert f.axes[0].get_xlabel() == "$X = x/g$"
     plt.close(f)
     b = bifurcation_diagram(p, "omega", [0.9, 0.91], transient=5, record=5)
@@ -228,4 +230,4 @@ def test_cli_poincare_and_resonance_write_outputs(tmp_path, capsys):
     assert "period 3" in out
     assert (tmp_path / "p.nc").stat().st_size > 0 and (tmp_path / "p.png").stat().st_size > 0
     ds = ns.io.load_dataset(tmp_path / "p.nc")
-    assert ds.attrs["period"] == 3 and ds.attrs["preset"] == "table3"
+    assert ds["period"] == 3 and ds.attrs["preset"] == "table3"

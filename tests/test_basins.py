@@ -42,10 +42,10 @@ def attractor_of(ds, point, tol=1e-4):
 
 def test_fractions_sum_to_one(fig7_110):
     ds = fig7_110
-    total = float(ds.fraction.sum()) + ds.attrs["undecided_fraction"]
+    total = float(ds.fraction.sum()) + float(ds.undecided_fraction)
     assert total == pytest.approx(1.0, abs=1e-12)
     n = GRID[0] * GRID[1]
-    assert int(ds["count"].sum()) + ds.attrs["undecided_count"] == n
+    assert int(ds["count"].sum()) + int(ds.undecided_count) == n
     for k in range(ds.sizes["attractor"]):
         assert ds.fraction[k] == pytest.approx(np.count_nonzero(ds.label.values == k) / n)
 
@@ -56,7 +56,7 @@ def test_fig7_two_coexisting_period1_attractors_with_and_without_contact(fig7_11
     assert list(ds.period.values) == [1, 1]
     assert list(ds.contact.values) == [0, 1]  # canonical order: no contact first
     assert ds.max_X[0] < 1.0 <= ds.max_X[1]
-    assert ds.attrs["undecided_fraction"] == 0.0
+    assert float(ds.undecided_fraction) == 0.0
     assert (ds.fraction > 0.1).all()
 
 
@@ -88,7 +88,7 @@ def test_linear_case_single_attractor_at_the_analytic_fixed_point():
     ds = basins(p, grid=(10, 10), x=(-2, 2), v=(-2, 2))
     assert ds.sizes["attractor"] == 1
     assert int(ds.period[0]) == 1 and int(ds.contact[0]) == 0
-    assert float(ds.fraction[0]) == 1.0 and ds.attrs["undecided_fraction"] == 0.0
+    assert float(ds.fraction[0]) == 1.0 and float(ds.undecided_fraction) == 0.0
     w, w0, xi, F0 = p.omega, p.omega0, p.xi, p.F0
     den = (w0**2 - w**2) ** 2 + (xi * w) ** 2
     X_ss, V_ss = F0 * (w0**2 - w**2) / den, F0 * xi * w / den * w

@@ -40,11 +40,11 @@ def test_eta_study_command_writes_dataset_and_figure(tmp_path, capsys):
     assert nc.is_file() and png.is_file() and png.stat().st_size > 1000
     ds = xr.open_dataset(nc, engine="h5netcdf").load()
     assert list(ds["eta"].values) == [0.1, 0.01, 0.001]
-    assert ds.attrs["exact_period"] == 1 and ds.attrs["exact_reaches_gamma_plus"] == 1
+    assert ds["exact_period"] == 1 and ds["exact_reaches_gamma_plus"] == 1
     # eta = 0.1 never enters Gamma+ (cf. Fig. 4a); the small ones agree with the exact orbit
     assert list(ds["reaches_gamma_plus"].values) == [0, 1, 1]
     assert list(ds["agrees"].values) == [0, 1, 1]
-    assert math.isclose(ds.attrs["recommended_eta"], 0.01)
+    assert math.isclose(ds["recommended_eta"], 0.01)
     assert ds["distance_to_exact"].values[2] < ds["distance_to_exact"].values[1]
     assert ds.attrs["preset"] == "fig6a" and "nonsmooth_version" in ds.attrs
     assert "recommended eta: 0.01" in out

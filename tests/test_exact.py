@@ -246,10 +246,10 @@ def test_status_codes_for_bad_input():
     p = preset("table3")
     code, _ = run(p, 2, x0=float("nan"))
     assert code == st.NON_FINITE
-    # undamped free flight forced exactly at resonance: no bounded closed form
+    # undamped free flight forced exactly at resonance: no bounded closed form, its own status
     q = Params(omega0=1.0, omega_s=10.0, xi=0.0, xi_s=0.3, F0=0.1, omega=1.0)
     code, _ = run(q, 2)
-    assert code == st.EVENT_FAILED
+    assert code == st.RESONANCE
 
 
 def test_initial_mode_classification():

@@ -91,7 +91,7 @@ def test_simulate_dataset_layout_and_provenance(tmp_path):
     T = p.period
     assert ds.sizes["t"] == 101
     np.testing.assert_allclose(ds.t.values, 3 * T + np.arange(101) * T / 50, rtol=1e-14)
-    assert ds.region.dtype == np.int8 and "legend" in ds.region.attrs
+    assert ds.region.dtype == np.int8 and "flag_meanings" in ds.region.attrs
     assert ds.attrs["nonsmooth_version"] == ns.__version__
     assert ds.attrs["method"] == "smooth" and ds.attrs["rtol"] == 1e-8
     assert ns.Params.from_attrs(ds.attrs) == p

@@ -73,7 +73,7 @@ def test_verdicts_are_computed_from_the_data(tmp_path, monkeypatch):
 
     def fake(params, **kw):
         ds = real(params, **kw)
-        ds.attrs["period"] = 5
+        ds["period"] = 5
         return ds
 
     monkeypatch.setattr(pc, "poincare", fake)

@@ -1,21 +1,65 @@
 """nonsmooth: nonlinear dynamics of non-smooth mechanical systems.
 
 Public API: :class:`Params`, :func:`preset`, :func:`simulate`, and the analyses.
+
+Importing the package is cheap and has no side effects: the public names are loaded on first
+use (PEP 562), so numba, xarray, scipy and matplotlib are imported, and the kernels compiled or
+loaded from numba's cache, only when a computation or a figure needs them.
 """
+
+from __future__ import annotations
+
+import importlib
+import sys
+import types
 
 from ._version import __version__
 from .errors import IntegrationError, NonsmoothError, OutputError, ParameterError
-from .kernels import Solver
-from .params import PARAM_NAMES, Params
-from .presets import PRESETS, preset
-from .simulate import simulate
-from .analysis.poincare import poincare
-from .analysis.bifurcation import bifurcation_diagram
-from .analysis.resonance import resonance_curve
-from .analysis.basins import basins
-from .analysis.eta_study import eta_study
-from .reproduction import reproduce
+
+#: Public name -> module (relative to this package) that defines it.
+_LAZY = {
+    "Params": ".params", "PARAM_NAMES": ".params",
+    "preset": ".presets", "PRESETS": ".presets",
+    "Solver": ".kernels",
+    "simulate": ".simulate",
+    "poincare": ".analysis.poincare",
+    "bifurcation_diagram": ".analysis.bifurcation",
+    "resonance_curve": ".analysis.resonance",
+    "basins": ".analysis.basins",
+    "eta_study": ".analysis.eta_study",
+    "reproduce": ".reproduction",
+}
+
+#: Subpackages and modules reachable as attributes (``ns.io``, ``ns.plot``, ...).
+_SUBMODULES = ("analysis", "cli", "errors", "integrate", "io", "kernels", "models", "params",
+               "plot", "presets", "reproduction", "status", "sweep")
 
 __all__ = ["__version__", "Params", "PARAM_NAMES", "preset", "PRESETS", "simulate", "reproduce", "Solver",
            "eta_study", "poincare", "bifurcation_diagram", "resonance_curve", "basins",
            "NonsmoothError", "ParameterError", "OutputError", "IntegrationError"]
+
+
+def __getattr__(name: str):
+    if name in _LAZY:
+        value = getattr(importlib.import_module(_LAZY[name], __name__), name)
+    elif name in _SUBMODULES:
+        value = importlib.import_module("." + name, __name__)
+    else:
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    globals()[name] = value
+    return value
+
+
+def __dir__():
+    return sorted(set(globals()) | set(__all__) | set(_SUBMODULES))
+
+
+class _Package(types.ModuleType):
+    def __setattr__(self, name, value):
+        # importing the submodule nonsmooth.simulate must not hide the function simulate
+        if isinstance(value, types.ModuleType) and _LAZY.get(name) == "." + name:
+            value = getattr(value, name)
+        super().__setattr__(name, value)
+
+
+sys.modules[__name__].__class__ = _Package

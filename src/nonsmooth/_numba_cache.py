@@ -149,8 +149,19 @@ def _kernel_set() -> frozenset:
     return _kernel_files
 
 
+#: Modules whose compilation takes most of a first run's wait.
+SLOW_MODULES = ("integrate.rkf45", "integrate.exact", "kernels")
+
+#: Called once, without arguments, when the kernels are first imported and the cache lacks
+#: today's ``SLOW_MODULES`` (compilation follows). The library never prints: the CLI sets
+#: this to tell the user.
+compile_notice = None
+
+
 def configure() -> None:
-    """Register the locator (idempotent). Imports numba's caching module, nothing heavier."""
+    """Register the locator (idempotent), and call ``compile_notice`` if compilation follows.
+    Imports numba's caching module, nothing heavier."""
+    global compile_notice
     from numba.core import caching
 
     impl = getattr(caching, "CacheImpl", None) or getattr(caching, "_CacheImpl")
@@ -158,3 +169,6 @@ def configure() -> None:
     if any(getattr(c, "__name__", "") == "KernelCacheLocator" for c in classes):
         return
     classes.insert(0, _locator_class())
+    if compile_notice is not None and not all(map(is_compiled, SLOW_MODULES)):
+        notice, compile_notice = compile_notice, None
+        notice()

@@ -14,7 +14,7 @@ class ParameterError(NonsmoothError, ValueError):
 
 
 class OutputError(NonsmoothError, OSError):
-    """A result file or figure cannot be written."""
+    """A result file or figure cannot be written, or a result file cannot be read."""
 
 
 class IntegrationError(NonsmoothError, RuntimeError):

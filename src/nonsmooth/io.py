@@ -1,9 +1,18 @@
-"""Result files: netCDF with flat provenance attributes, and figure output."""
+"""Result files: netCDF with flat provenance attributes, and figure output.
+
+Every file is written atomically (:func:`atomic_path`): to a temporary name in its folder,
+renamed onto the target when complete, so a previous result is never destroyed by a failed,
+interrupted or killed write, and the files written are recorded (:func:`written_files`).
+"""
 
 from __future__ import annotations
 
+import contextlib
 import math
 import os
+import stat
+import sys
+import uuid
 from pathlib import Path
 
 import numpy as np
@@ -39,16 +48,19 @@ def status_flags(**extra) -> dict:
     return flag_attrs(list(names.values()), list(names), dtype=np.int64, **extra)
 
 
-def provenance_attrs(params=None, solver=None, **extra) -> dict:
-    """Flat, netCDF-safe attrs: ``Conventions``, ``param_*`` for the parameters, the solver
-    settings, the package version and any ``extra`` (bools become 0/1, None becomes "")."""
+def provenance_attrs(params=None, solver=None, swept=(), **extra) -> dict:
+    """Flat, netCDF-safe attrs: ``Conventions``, ``param_*`` for the parameters except the
+    ``swept`` ones (coordinates of the result: a base value in the attrs would be read back as
+    the point, see ``Params.from_attrs``), the solver settings, the package version and any
+    ``extra`` (bools become 0/1, None becomes "")."""
     import numba
     import scipy
     attrs = {"Conventions": CONVENTIONS, "nonsmooth_version": __version__,
              "numpy_version": np.__version__,
              "scipy_version": scipy.__version__, "numba_version": numba.__version__}
     if params is not None:
-        attrs.update(params.attrs())
+        attrs.update({k: v for k, v in params.attrs().items()
+                      if k.removeprefix("param_") not in swept})
     if solver is not None:
         attrs.update(solver.attrs())
     attrs.update(extra)
@@ -85,39 +97,108 @@ def check_writable(path, what: str = "output") -> Path:
     return p
 
 
+_written: list[Path] = []
+
+
+def written_files() -> list[Path]:
+    """The files this process has written through this module, in order (for the CLI's
+    message when a run is interrupted)."""
+    return list(_written)
+
+
+@contextlib.contextmanager
+def atomic_path(path, what: str = "output"):
+    """Yield a temporary path in the folder of ``path`` to write the whole file to; when the
+    block completes the file is renamed onto ``path`` (``os.replace``: readers, even one that
+    holds the old file open, see the old file or the new one, never a partial one). On any
+    failure or interruption the temporary file is removed and ``path`` is untouched; an OSError
+    becomes a one-line OutputError naming ``what`` and the path."""
+    p = check_writable(path, what)
+    tmp = p.with_name(f".{p.name}.{uuid.uuid4().hex[:8]}.part")
+    try:
+        os.close(os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o666))  # umask applies
+        if p.exists():
+            os.chmod(tmp, stat.S_IMODE(p.stat().st_mode))
+        yield tmp
+        os.replace(tmp, p)
+    except BaseException as exc:
+        with contextlib.suppress(OSError):
+            tmp.unlink()
+        if isinstance(exc, OSError) and not isinstance(exc, OutputError):
+            raise OutputError(f"{what}: cannot write {str(p)!r}: "
+                              f"{exc.strerror or exc}; {_previous(p)}") from None
+        raise
+    _written.append(p)
+
+
+def _previous(p: Path) -> str:
+    return "the previous file is untouched" if p.exists() else "nothing written"
+
+
+def write_file(path, data: str | bytes, what: str = "output") -> Path:
+    """Write ``data`` (text as UTF-8, or bytes) to ``path`` atomically (:func:`atomic_path`)."""
+    with atomic_path(path, what) as tmp:
+        tmp.write_bytes(data.encode("utf-8") if isinstance(data, str) else data)
+    return Path(path)
+
+
 def save_dataset(ds, path) -> Path:
-    """Write ``ds`` to netCDF (h5netcdf engine)."""
-    p = check_writable(path, "output")
+    """Write ``ds`` to netCDF4 (h5netcdf engine) atomically (:func:`atomic_path`), with flat
+    netCDF-safe attributes and a ``Conventions`` attribute."""
     ds = ds.copy()
-    ds.attrs = clean_attrs(ds.attrs)
+    ds.attrs = clean_attrs({"Conventions": CONVENTIONS, **ds.attrs})
     for v in ds.variables.values():
         v.attrs = clean_attrs(v.attrs)
-    try:
-        ds.to_netcdf(p, engine="h5netcdf")
-    except OSError as exc:
-        raise OutputError(f"output: cannot write {str(p)!r}: {exc.strerror or exc}") from None
-    return p
+    with atomic_path(path, "output") as tmp:
+        try:
+            ds.to_netcdf(tmp, engine="h5netcdf")
+        except ValueError as exc:  # h5netcdf refuses some types and names
+            raise OSError(str(exc)) from None
+    return Path(path)
 
 
 def load_dataset(path):
+    """Read a netCDF result file written by :func:`save_dataset` into memory (the file is
+    closed on return). A missing or non-netCDF file raises a one-line OutputError."""
     import xarray as xr
     p = Path(path)
     if not p.is_file():
         raise OutputError(f"input: no such file {str(p)!r}")
-    with xr.open_dataset(p, engine="h5netcdf") as ds:
-        return ds.load()
-
-
-def save_figure(fig, path, dpi: int = 150) -> Path:
-    """Save a matplotlib figure (format from the suffix) and close it."""
-    import matplotlib.pyplot as plt
-    p = check_writable(path, "plot")
     try:
-        fig.savefig(p, dpi=dpi, bbox_inches="tight")
+        with xr.open_dataset(p, engine="h5netcdf") as ds:
+            return ds.load()
     except (OSError, ValueError) as exc:
-        raise OutputError(f"plot: cannot write {str(p)!r}: {exc}") from None
+        raise OutputError(f"input: cannot read {str(p)!r} as netCDF: {exc}") from None
+
+
+def figure_path(path, what: str = "plot") -> Path:
+    """The file a figure saved to ``path`` is written to: the format is the suffix (one of
+    matplotlib's formats, else a one-line OutputError naming ``what``); no suffix means PNG,
+    with ``.png`` appended (as matplotlib does). Checks that it can be written."""
+    from matplotlib.backend_bases import FigureCanvasBase
+    p = Path(path)
+    fmt = p.suffix[1:].lower()
+    if not fmt:
+        p = p.with_name(p.name + ".png")
+    elif fmt not in FigureCanvasBase.get_supported_filetypes():
+        known = ", ".join(sorted(FigureCanvasBase.get_supported_filetypes()))
+        raise OutputError(f"{what}: unknown figure format {fmt!r} in {str(path)!r} (known: {known})")
+    return check_writable(p, what)
+
+
+def save_figure(fig, path, dpi: int = 150, what: str = "plot") -> Path:
+    """Save a matplotlib figure atomically (format from the suffix, see :func:`figure_path`)
+    and return the path written. A pyplot figure is also closed."""
+    p = figure_path(path, what)
+    try:
+        with atomic_path(p, what) as tmp:
+            try:
+                fig.savefig(tmp, format=p.suffix[1:].lower(), dpi=dpi, bbox_inches="tight")
+            except ValueError as exc:
+                raise OSError(str(exc)) from None
     finally:
-        plt.close(fig)
+        if "matplotlib.pyplot" in sys.modules:
+            sys.modules["matplotlib.pyplot"].close(fig)
     return p
 
 

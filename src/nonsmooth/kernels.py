@@ -74,10 +74,20 @@ class Solver:
              "max_steps_per_period": int(self.max_steps)}
         if self.method == "smooth":
             a["transition"] = self.transition
-            a["integrator"] = "RKF45 (5th-order propagation, PI control, located switches)"
+            a["integrator"] = smooth_integrator()
         else:
             a["integrator"] = "closed form between located switching events"
         return a
+
+
+def smooth_integrator() -> str:
+    """Description of the smoothed-model integrator, read from the constants of the code that
+    runs (``integrate.rkf45``: propagated order, step-size controller)."""
+    from .integrate import rkf45 as k
+    q = k.RKF45_ORDER
+    return (f"RKF45 (order-{q + 1} propagation, elementary step-size control "
+            f"h_new = {k._SAFETY:g} h err^(-{k._EXPO:g}) limited to [{k._FAC_MIN:g}, "
+            f"{k._FAC_MAX:g}] h, located switches)")
 
 
 def new_state(x0: float, v0: float) -> np.ndarray:

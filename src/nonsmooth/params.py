@@ -136,8 +136,28 @@ class Params:
         return {f"param_{k}": float(v) for k, v in self.as_dict().items()}
 
     @classmethod
-    def from_attrs(cls, attrs) -> "Params":
-        return cls(**{n: float(attrs[f"param_{n}"]) for n in PARAM_NAMES})
+    def from_attrs(cls, source, **point) -> "Params":
+        """The parameters of a result: ``source`` is a Dataset (or an attrs dict) with
+        ``param_<name>`` attributes. A parameter swept in the Dataset (a coordinate or variable
+        of that name) must be given in ``point`` (``Params.from_attrs(ds, omega=0.92)``): its
+        value is a point of the sweep, never an attribute. One-line ParameterError otherwise."""
+        variables = getattr(source, "variables", {})
+        attrs = getattr(source, "attrs", source)
+        if unknown := sorted(set(point) - set(PARAM_NAMES)):
+            raise ParameterError(f"{unknown[0]}: unknown parameter (known: {', '.join(PARAM_NAMES)})")
+        values = {}
+        for n in PARAM_NAMES:
+            if n in point:
+                values[n] = point[n]
+            elif n in variables:
+                raise ParameterError(f"{n}: swept in this dataset; give the point, e.g. "
+                                     f"Params.from_attrs(ds, {n}=...)")
+            elif f"param_{n}" in attrs:
+                values[n] = float(attrs[f"param_{n}"])
+            else:
+                raise ParameterError(f"{n}: no param_{n} attribute (a swept parameter?); give "
+                                     f"its value, e.g. Params.from_attrs(attrs, {n}=...)")
+        return cls(**values)
 
 
 def check_param_name(name: str) -> str:

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import warnings
 
 import numpy as np
 import xarray as xr
@@ -11,8 +12,7 @@ from . import status as st
 from .errors import IntegrationError, ParameterError
 from .integrate.contract import ST_MODE
 from .io import provenance_attrs
-from .kernels import Solver, advance, new_state, output_buffers
-from .models.switch import REGION_LEGEND
+from .kernels import Solver, new_state
 from .params import Params
 
 
@@ -54,9 +54,40 @@ def start_trajectory(params, x0, v0, method, rtol, atol, transition):
     return params, solver, params.pack(), solver.opts(), new_state(x0, v0)
 
 
-def simulate(params: Params, *, periods: int, transient: int = 0, samples_per_period: int = 100,
-             x0: float = 0.0, v0: float = 0.0, method: str = "smooth", rtol: float = 1e-8,
-             atol: float = 1e-10, transition: str = "eq13") -> xr.Dataset:
+def renamed(name: str, value, old_name: str, old_value, default=None):
+    """Value of keyword ``name`` given either as ``name`` or under its deprecated ``old_name``
+    (accepted for one release, with a DeprecationWarning), else ``default``; one-line
+    ParameterError if both are given, or neither without a default."""
+    if old_value is not None:
+        if value is not None:
+            raise ParameterError(f"{name}: give {name} only ({old_name} is its deprecated name)")
+        warnings.warn(f"{old_name}= is deprecated, use {name}=", DeprecationWarning, stacklevel=3)
+        return old_value
+    if value is None and default is not None:
+        return default
+    if value is None:
+        raise ParameterError(f"{name}: required (the number of forcing periods recorded)")
+    return value
+
+
+def mask_names(var, mask=None) -> list[str]:
+    """The flag meanings set in a bit-mask variable with CF ``flag_masks`` (its value, or
+    ``mask``)."""
+    mask = int(var.values if mask is None else mask)
+    names = var.attrs["flag_meanings"].split()
+    return [w for w, m in zip(names, np.asarray(var.attrs["flag_masks"])) if mask & int(m)]
+
+
+#: Samples per forcing period of :func:`simulate` (and of ``nonsmooth simulate``).
+SAMPLES_PER_PERIOD = 200
+#: Bytes held per sample (X, V, X_max, X_min, t: float64; region, visited: 1 byte).
+_SAMPLE_BYTES = 5 * 8 + 2
+
+
+def simulate(params: Params, *, periods: int, transient: int = 0,
+             samples_per_period: int = SAMPLES_PER_PERIOD, x0: float = 0.0, v0: float = 0.0,
+             method: str = "smooth", rtol: float = 1e-8, atol: float = 1e-10,
+             transition: str = "eq13", progress=None) -> xr.Dataset:
     """Integrate one trajectory from (x0, v0) at t = 0 (forcing phase 0).
 
     After ``transient`` whole forcing periods T = 2 pi/omega, the state is sampled at
@@ -65,42 +96,75 @@ def simulate(params: Params, *, periods: int, transient: int = 0, samples_per_pe
     system of eqs. 4, 7-9 (closed form between located switching events).
 
     Returns a Dataset with coordinate ``t`` and variables ``X``, ``V``, ``region``
-    (0 Gamma-, 1 Sigma_alpha, 2 Sigma_beta, 3 Gamma+; the exact model uses 0 and 3) and
+    (0 Gamma-, 1 Sigma_alpha, 2 Sigma_beta, 3 Gamma+; the exact model uses 0 and 3; CF flags),
     ``visited`` (bit mask of the regions visited since the previous sample, so that a pass
-    through a thin band between two samples is not lost).
+    through a thin band between two samples is not lost; CF flag_masks), ``X_max``, ``X_min``
+    (the true extremes of X since the previous sample, interior extrema included; at the first
+    sample X itself) and the scalars ``max_X``, ``min_X`` (true extremes over the whole
+    recorded run) and ``regions_visited`` (bit mask over the run). The run is integrated in
+    time slices; ``progress(done, total)`` (in forcing periods) is called between them.
     """
+    from .io import check_memory, flag_attrs, format_bytes
+    from .models.switch import REGION_NAMES
+    from .sweep import run_trajectories
     params, solver, p, opts, state = start_trajectory(params, x0, v0, method, rtol, atol,
                                                       transition)
     periods = check_int("periods", periods, 1)
     transient = check_int("transient", transient, 0)
     spp = check_int("samples_per_period", samples_per_period, 1)
-    x0, v0 = float(state[0]), float(state[1])
-    empty = output_buffers(0)
-    code = advance(solver.code, p, opts, state, 1, transient, 0, *empty)
-    if code != st.OK:
-        raise IntegrationError(f"simulate: transient failed: {st.message(code)}")
     n = periods * spp
-    X, V, R, M, _xmax, _xmin = output_buffers(n + 1)
-    X[0], V[0], R[0] = state[0], state[1], int(state[ST_MODE])
-    M[0] = 1 << R[0]
-    code = advance(solver.code, p, opts, state, spp, 0, n, X[1:], V[1:], R[1:], M[1:],
-                   _xmax[1:], _xmin[1:])
-    if code != st.OK:
-        raise IntegrationError(f"simulate: integration failed: {st.message(code)}")
+    check_memory(_SAMPLE_BYTES * (n + 1.0), "periods",
+                 f"record fewer periods or samples per period ({n + 1} samples at "
+                 f"{format_bytes(_SAMPLE_BYTES)} each)")
+    x0, v0 = float(state[0]), float(state[1])
+    P = p[None, :]
+    total = transient + periods
+    report = None if progress is None else (lambda d, _t: progress(d, total))
+    tr = run_trajectories(P, solver, state[None, :], per_period=1, n_skip=transient, n_out=0,
+                          workers=1, progress=report)
+    if tr["status"][0] != st.OK:
+        raise IntegrationError(f"simulate: transient failed: {st.message(tr['status'][0])}")
+    state = tr["state"][0]
+    if progress is not None:
+        report = lambda d, _t: progress(transient + d, total)  # noqa: E731
+    rec = run_trajectories(P, solver, state[None, :], per_period=spp, n_skip=0, n_out=n,
+                           workers=1, progress=report)
+    if rec["status"][0] != st.OK:
+        raise IntegrationError(f"simulate: integration failed: {st.message(rec['status'][0])}")
+    X = np.concatenate([[state[0]], rec["X"][0]])
+    V = np.concatenate([[state[1]], rec["V"][0]])
+    R = np.concatenate([[int(state[ST_MODE])], rec["R"][0]]).astype(np.int8)
+    M = np.concatenate([[1 << int(R[0])], rec["M"][0]]).astype(np.uint8)
+    Xmax = np.concatenate([[state[0]], rec["Xmax"][0]])
+    Xmin = np.concatenate([[state[0]], rec["Xmin"][0]])
     T = params.period
     t0 = transient * T
     t = t0 + np.arange(n + 1) * (T / spp)
+    regions = flag_attrs(REGION_NAMES, dtype=np.int8)
+    masks = flag_attrs(REGION_NAMES, dtype=np.uint8, masks=True)
     ds = xr.Dataset(
         {
             "X": ("t", X, {"long_name": "displacement X = x/g", "units": "1"}),
             "V": ("t", V, {"long_name": "velocity dX/dt", "units": "1/s"}),
-            "region": ("t", R, {"long_name": "region of eq. 14 at t", "legend": REGION_LEGEND}),
-            "visited": ("t", M, {"long_name": "regions visited since the previous sample",
-                                 "legend": "bit mask, bit r set = region code r visited"}),
+            "region": ("t", R, dict(regions, long_name="region of eq. 14 at t")),
+            "visited": ("t", M, dict(masks, long_name="regions visited since the previous "
+                                                      "sample")),
+            "X_max": ("t", Xmax, {"long_name": "largest X since the previous sample (interior "
+                                               "extrema included)", "units": "1"}),
+            "X_min": ("t", Xmin, {"long_name": "smallest X since the previous sample (interior "
+                                               "extrema included)", "units": "1"}),
+            "max_X": ((), float(Xmax.max()), {"long_name": "largest X over the recorded run "
+                                                           "(interior extrema included)",
+                                              "units": "1"}),
+            "min_X": ((), float(Xmin.min()), {"long_name": "smallest X over the recorded run "
+                                                           "(interior extrema included)",
+                                              "units": "1"}),
+            "regions_visited": ((), np.bitwise_or.reduce(M), dict(
+                masks, long_name="regions visited over the recorded run")),
         },
         coords={"t": ("t", t, {"long_name": "time", "units": "s"})},
         attrs=provenance_attrs(params, solver, analysis="simulate", periods=periods,
                                transient=transient, samples_per_period=spp, x0=x0, v0=v0,
-                               forcing_period=T, region_legend=REGION_LEGEND),
+                               forcing_period=T),
     )
     return ds

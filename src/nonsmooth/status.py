@@ -6,6 +6,7 @@ STEP_TOO_SMALL = 2
 NON_FINITE = 3
 ZENO = 4  # accumulation of ever shorter contacts (exact solver)
 EVENT_FAILED = 5  # an event could not be located (should not happen)
+RESONANCE = 6  # exact solver: an undamped mode forced exactly at its resonance
 
 MESSAGES = {
     OK: "ok",
@@ -14,6 +15,9 @@ MESSAGES = {
     NON_FINITE: "non-finite state",
     ZENO: "accumulation of ever shorter contacts (Zeno)",
     EVENT_FAILED: "event location failed",
+    RESONANCE: ("undamped mode forced exactly at resonance (xi = 0 and omega = omega0, or in "
+                "contact xi + xi_s = 0 and omega^2 = omega0^2 + omega_s^2): the exact solver has "
+                "no bounded closed form there; method=\"smooth\" handles it"),
 }
 
 #: One word per status for CF ``flag_meanings``.
@@ -24,6 +28,7 @@ FLAG_NAMES = {
     NON_FINITE: "non_finite_state",
     ZENO: "zeno_accumulation",
     EVENT_FAILED: "event_location_failed",
+    RESONANCE: "undamped_resonance",
 }
 
 

@@ -20,20 +20,44 @@ from .kernels import Solver, advance
 from .integrate.contract import N_STATE
 
 
-@nb.njit(cache=True, parallel=True)
+_F2 = nb.float64[:, :]
+#: one signature (any layout): time slices of the outputs are non-contiguous views
+_RUN_MANY_SIG = nb.void(nb.int64, _F2, nb.float64[:], _F2, nb.int64, nb.int64, nb.int64, _F2, _F2,
+                        nb.int8[:, :], nb.uint8[:, :], _F2, _F2, nb.int64[:])
+
+
+@nb.njit(_RUN_MANY_SIG, cache=True, parallel=True)
 def _run_many(method, P, opts, states, per_period, n_skip, n_out, X, V, R, M, Xmax, Xmin, status):
-    n = P.shape[0]
-    for i in nb.prange(n):
-        status[i] = advance(method, P[i], opts, states[i], per_period, n_skip, n_out,
-                            X[i], V[i], R[i], M[i], Xmax[i], Xmin[i])
-        if status[i] != 0:
-            for k in range(n_out):
-                X[i, k] = np.nan
-                V[i, k] = np.nan
-                Xmax[i, k] = np.nan
-                Xmin[i, k] = np.nan
-                R[i, k] = -1
-                M[i, k] = 0
+    """One slice of every trajectory whose ``status`` is still 0 (failed ones are skipped)."""
+    for i in nb.prange(P.shape[0]):
+        if status[i] == 0:
+            status[i] = advance(method, P[i], opts, states[i], per_period, n_skip, n_out,
+                                X[i], V[i], R[i], M[i], Xmax[i], Xmin[i])
+
+
+#: Seconds of work per compiled call of a long run: Ctrl-C (KeyboardInterrupt) and progress
+#: reports happen between calls, so a run stops within about this time of a SIGINT.
+SLICE_SECONDS = 0.1
+
+
+class Slicer:
+    """Sizes of the slices of a long run (forcing periods per trajectory and compiled call):
+    each slice is sized from the measured speed of the previous one so that a call takes about
+    ``SLICE_SECONDS`` (growing at most 4x per slice, never below ``minimum``). The kernels are
+    split-invariant (contract), so the results do not depend on the slices."""
+
+    def __init__(self, first: int = 1, minimum: int = 1):
+        self.minimum = max(1, int(minimum))
+        self.size = max(self.minimum, int(first))
+
+    def run(self, call):
+        """``call(size)`` once, timed; adapts the next size. Returns what ``call`` returns."""
+        t0 = time.perf_counter()
+        res = call(self.size)
+        dt = time.perf_counter() - t0
+        grow = 4.0 if dt <= 0.0 else min(4.0, SLICE_SECONDS / dt)
+        self.size = max(self.minimum, int(self.size * grow))
+        return res
 
 
 def resolve_workers(workers: int | None) -> int:
@@ -64,7 +88,9 @@ def run_trajectories(P, solver: Solver, states, *, per_period: int, n_skip: int,
     of T/per_period, recording the last ``n_out`` (see ``integrate.contract``).
 
     Returns a dict with X, V, R, M, Xmax, Xmin of shape (n, n_out), ``status`` (n,) and the
-    final ``state`` (n, 5). ``progress(done, total)`` is called after each chunk.
+    final ``state`` (n, 5). The trajectories are run in chunks of ``chunk`` and each chunk in
+    time slices (:class:`Slicer`); ``progress(done, total)`` is called after each slice, in
+    trajectory-periods.
     """
     P = np.ascontiguousarray(np.atleast_2d(np.asarray(P, dtype=np.float64)))
     states = np.array(states, dtype=np.float64, copy=True).reshape(-1, N_STATE)
@@ -81,21 +107,43 @@ def run_trajectories(P, solver: Solver, states, *, per_period: int, n_skip: int,
     nw = resolve_workers(workers)
     if chunk is None:
         chunk = max(4 * nw, n // 50 or 1)
+    total = n_skip + n_out  # intervals of T/per_period
     with threads(nw):
         for a in range(0, n, chunk):
             b = min(n, a + chunk)
-            _run_many(solver.code, P[a:b], opts, states[a:b], per_period, n_skip, n_out,
-                      out["X"][a:b], out["V"][a:b], out["R"][a:b], out["M"][a:b],
-                      out["Xmax"][a:b], out["Xmin"][a:b], out["status"][a:b])
-            if progress is not None:
-                progress(b, n)
+            slicer = Slicer()
+            k = 0
+            while True:  # one call at least, also for no intervals (it classifies the mode)
+                m = min(total - k, slicer.size * per_period)
+                skip = max(0, min(k + m, n_skip) - k)
+                o0, o1 = max(k, n_skip) - n_skip, k + m - n_skip
+                o1 = max(o0, o1)
+                slicer.run(lambda _size: _run_many(
+                    solver.code, P[a:b], opts, states[a:b], per_period, skip, o1 - o0,
+                    out["X"][a:b, o0:o1], out["V"][a:b, o0:o1], out["R"][a:b, o0:o1],
+                    out["M"][a:b, o0:o1], out["Xmax"][a:b, o0:o1], out["Xmin"][a:b, o0:o1],
+                    out["status"][a:b]))
+                k += m
+                if progress is not None:
+                    progress((a * total + (b - a) * k) // per_period, n * total // per_period)
+                if k >= total:
+                    break
+    failed = out["status"] != 0
+    for key in ("X", "V", "Xmax", "Xmin"):
+        out[key][failed] = np.nan
+    out["R"][failed] = -1
+    out["M"][failed] = 0
     out["state"] = states
     return out
 
 
 class Progress:
     """A rich progress bar with ETA that only appears for runs longer than ``delay`` seconds
-    and only on a terminal (or when NONSMOOTH_PROGRESS=1)."""
+    and only on a terminal; with NONSMOOTH_PROGRESS=1 and no terminal, plain progress lines.
+    ``progress(done, total)`` may report any unit of work (points, forcing periods)."""
+
+    #: Seconds between two plain progress lines.
+    LINE_EVERY = 10.0
 
     def __init__(self, description: str, delay: float = 2.0, enabled: bool | None = None):
         self.description = description
@@ -107,9 +155,13 @@ class Progress:
         self._bar = None
         self._task = None
         self._t0 = time.perf_counter()
+        self._next_line = 0.0
 
     def __call__(self, done: int, total: int):
         if not self.enabled:
+            return
+        if not (hasattr(os.sys.stderr, "isatty") and os.sys.stderr.isatty()):
+            self._line(done, total)
             return
         if self._bar is None:
             if time.perf_counter() - self._t0 < self.delay and done < total:
@@ -125,6 +177,17 @@ class Progress:
         self._bar.update(self._task, completed=done, total=total)
         if done >= total:
             self.close()
+
+    def _line(self, done: int, total: int):
+        """Not on a terminal (a log, NONSMOOTH_PROGRESS=1): a plain line every LINE_EVERY
+        seconds after ``delay``, with the fraction done and the time left at the mean rate."""
+        now = time.perf_counter() - self._t0
+        if now < self.delay or now < self._next_line or done >= total or done <= 0:
+            return
+        self._next_line = now + self.LINE_EVERY
+        left = now * (total - done) / done
+        print(f"{self.description}: {100.0 * done / total:.1f}% of {total}, "
+              f"{now:.0f} s elapsed, about {left:.0f} s left", file=os.sys.stderr, flush=True)
 
     def close(self):
         if self._bar is not None:

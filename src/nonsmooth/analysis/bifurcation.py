@@ -13,6 +13,8 @@ that branch from (x0, v0) at the next value.
 
 from __future__ import annotations
 
+import math
+
 import numba as nb
 import numpy as np
 import xarray as xr
@@ -20,10 +22,10 @@ import xarray as xr
 from .. import status as st
 from ..errors import ParameterError
 from ..io import provenance_attrs
-from ..kernels import METHOD_SMOOTH, Solver
+from ..kernels import METHOD_SMOOTH, Solver, advance
 from ..models.switch import beta_ratio, inside_margin
 from ..params import IDX, PARAM_INFO, Params, check_param_name
-from .poincare import MAX_PERIOD, classify, settle_and_record, settle_tolerance
+from .poincare import MAX_PERIOD, PERIOD_LONG_NAME, SETTLE_WINDOW, classify, settle, settle_tolerance
 
 SWEEPS = ("up", "down", "both", "fresh")
 
@@ -48,32 +50,76 @@ _I8_2 = nb.int64[:, :]
 #: sweeps are contiguous; without it numba would compile and cache both versions
 _CONTINUATION_SIG = nb.void(nb.int64, _F3, nb.float64[:], nb.float64[:, :], nb.float64[:], nb.int64,
                             nb.float64, _F3, _F3, nb.int8[:, :, :], nb.uint8[:, :, :], _F3, _F3,
-                            _I8_2, _I8_2, _F3)
+                            _I8_2, _I8_2, _F3, _I8_2, nb.int64)
+
+#: Columns of the per-branch progress counters ``prog`` of :func:`continuation`: the value
+#: index, the transient periods done at that value, the phase, the section points recorded.
+PG_VALUE, PG_DONE, PG_PHASE, PG_REC = 0, 1, 2, 3
+N_PROG = 4
+_START, _SETTLE, _RECORD = 0, 1, 2
 
 
 @nb.njit(_CONTINUATION_SIG, cache=True, parallel=True)
 def continuation(method, P, opts, states, init, transient, settle_tol,
-                 X, V, R, M, Xmax, Xmin, status, used, S):
+                 X, V, R, M, Xmax, Xmin, status, used, S, prog, budget):
     """For every branch b (in parallel) and parameter row i (in order): continue
     ``states[b]`` with parameters ``P[b, i]`` for ``transient`` periods (ended early when
-    settled, ``settle_tol`` > 0) and record ``X.shape[2]`` section points into
-    ``X[b, i]`` ... and the state after it into ``S[b, i]``. A failed point gets NaN outputs
-    and status != 0, and the branch restarts from ``init`` at the next row. ``states`` is
-    updated in place (resumable)."""
+    settled, ``settle_tol`` > 0, see ``poincare.settle``) and record ``X.shape[2]`` section
+    points into ``X[b, i]`` ... and the state after it into ``S[b, i]``. A failed point gets
+    NaN outputs and status != 0, and the branch restarts from ``init`` at the next row.
+
+    Resumable: each call integrates about ``budget`` forcing periods per branch and returns;
+    ``states`` and the progress counters ``prog`` (branch, N_PROG; zeros to start) are updated
+    in place, and the next call goes on from there. Calls cut on settle-window and period
+    boundaries, so the results do not depend on the budgets."""
     nb_, ni = P.shape[0], P.shape[1]
+    nrec = X.shape[2]
     for b in nb.prange(nb_):
-        for i in range(ni):
-            _fix_mode(method, P[b, i], states[b])
-            code, u = settle_and_record(method, P[b, i], opts, states[b], transient, settle_tol,
-                                        X[b, i], V[b, i], R[b, i], M[b, i], Xmax[b, i],
-                                        Xmin[b, i])
-            status[b, i] = code
-            used[b, i] = u
+        work = 0
+        while prog[b, PG_VALUE] < ni and work < budget:
+            i = prog[b, PG_VALUE]
+            if prog[b, PG_PHASE] == _START:
+                _fix_mode(method, P[b, i], states[b])
+                prog[b, PG_DONE] = 0
+                prog[b, PG_REC] = 0
+                prog[b, PG_PHASE] = _SETTLE
+            code = 0
+            if prog[b, PG_PHASE] == _SETTLE:
+                d0 = prog[b, PG_DONE]
+                code, d, fin = settle(method, P[b, i], opts, states[b], transient, settle_tol,
+                                      d0, budget - work)
+                work += d - d0
+                prog[b, PG_DONE] = d
+                if code == 0 and fin:
+                    prog[b, PG_PHASE] = _RECORD
+            if code == 0 and prog[b, PG_PHASE] == _RECORD and (work < budget or nrec == 0):
+                r = prog[b, PG_REC]
+                n = min(nrec - r, max(budget - work, 1))
+                code = advance(method, P[b, i], opts, states[b], 1, 0, n, X[b, i, r:r + n],
+                               V[b, i, r:r + n], R[b, i, r:r + n], M[b, i, r:r + n],
+                               Xmax[b, i, r:r + n], Xmin[b, i, r:r + n])
+                work += n
+                prog[b, PG_REC] = r + n
+                if code == 0 and r + n == nrec:
+                    prog[b, PG_PHASE] = _START
             if code != 0:
+                for k in range(nrec):
+                    X[b, i, k] = np.nan
+                    V[b, i, k] = np.nan
+                    Xmax[b, i, k] = np.nan
+                    Xmin[b, i, k] = np.nan
+                    R[b, i, k] = -1
+                    M[b, i, k] = 0
+                prog[b, PG_PHASE] = _START
+            if prog[b, PG_PHASE] == _START:  # this value is finished
+                status[b, i] = code
+                used[b, i] = prog[b, PG_DONE]
+                if code != 0:
+                    for k in range(states.shape[1]):
+                        states[b, k] = init[k]
                 for k in range(states.shape[1]):
-                    states[b, k] = init[k]
-            for k in range(states.shape[1]):
-                S[b, i, k] = states[b, k]
+                    S[b, i, k] = states[b, k]
+                prog[b, PG_VALUE] = i + 1
 
 
 def check_values(name: str, values) -> np.ndarray:
@@ -93,8 +139,58 @@ def check_values(name: str, values) -> np.ndarray:
 
 
 def param_rows(params: Params, param: str, values) -> np.ndarray:
-    """Packed parameters, one row per value (each validated by Params)."""
-    return np.stack([params.replace(**{param: float(x)}).pack() for x in values])
+    """Packed parameters, one row per value. Every constraint of Params is an interval in
+    each parameter, so validating the smallest and the largest value validates them all."""
+    values = np.asarray(values, dtype=np.float64)
+    for x in (values.min(), values.max()):
+        params.replace(**{param: float(x)})
+    rows = np.tile(params.pack(), (values.size, 1))
+    rows[:, IDX[param]] = values
+    return rows
+
+
+def check_sweep_memory(n_values: int, n_branches: int, record: int) -> None:
+    """Refuse, before computing, a sweep whose section data would not fit in memory."""
+    from ..io import check_memory
+    check_memory(34.0 * n_values * n_branches * record, "record",
+                 "record fewer section points per value, or sweep fewer values")
+
+
+def follow(P, solver: Solver, states, init, transient: int, settle_tol: float, record: int,
+           *, workers=None, progress=None, group: int | None = None):
+    """Run :func:`continuation` over the packed parameters ``P`` (branch, value, 7) from
+    ``states`` (branch, 5; updated in place) in time slices (``sweep.Slicer``: each compiled
+    call returns to Python after about 0.1 s, so Ctrl-C stops it and progress is reported,
+    ``progress(done, total)`` in periods of the planned work), ``group`` branches at a time.
+    Returns dict of X, V, R, M, Xmax, Xmin (branch, value, record), ``status`` and ``used``
+    (branch, value) and ``S`` (branch, value, 5)."""
+    from ..sweep import Slicer, threads
+    nbr, nval = P.shape[0], P.shape[1]
+    X = np.empty((nbr, nval, record))
+    out = {"X": X, "V": np.empty_like(X), "R": np.empty(X.shape, np.int8),
+           "M": np.empty(X.shape, np.uint8), "Xmax": np.empty_like(X),
+           "Xmin": np.empty_like(X), "status": np.zeros((nbr, nval), np.int64),
+           "used": np.zeros((nbr, nval), np.int64), "S": np.empty((nbr, nval, states.shape[1]))}
+    prog = np.zeros((nbr, N_PROG), np.int64)
+    opts = solver.opts()
+    per_value = transient + record
+    group = nbr if group is None else max(1, group)
+    with threads(workers):
+        for a in range(0, nbr, group):
+            b = min(nbr, a + group)
+            sl = Slicer(first=SETTLE_WINDOW, minimum=SETTLE_WINDOW)
+            args = [v[a:b] for v in (out["X"], out["V"], out["R"], out["M"], out["Xmax"],
+                                     out["Xmin"], out["status"], out["used"], out["S"])]
+            while np.any(prog[a:b, PG_VALUE] < nval):
+                sl.run(lambda size: continuation(solver.code, P[a:b], opts, states[a:b], init,
+                                                 transient, settle_tol, *args, prog[a:b], size))
+                if progress is not None:
+                    g = prog[:b]
+                    part = np.where(g[:, PG_PHASE] == _RECORD, transient + g[:, PG_REC],
+                                    np.where(g[:, PG_PHASE] == _SETTLE, g[:, PG_DONE], 0))
+                    progress(int(np.sum(g[:, PG_VALUE] * per_value + part)),
+                             nbr * nval * per_value)
+    return out
 
 
 def run_branches(params: Params, param: str, values, solver: Solver, *, directions,
@@ -104,15 +200,12 @@ def run_branches(params: Params, param: str, values, solver: Solver, *, directio
     or "fresh". Returns dict of arrays (branch, value, n) in ascending value order, plus
     ``status`` and ``used`` (branch, value), ``S`` the kernel state after each value
     (branch, value, 5) and the final ``state`` per branch.
-    ``progress(done, total)`` is called after each chunk of values."""
+    ``progress(done, total)`` is called after each time slice (see :func:`follow`)."""
     from ..kernels import new_state
-    from ..sweep import threads
     values = np.asarray(values, dtype=np.float64)
     nv = values.size
     rows = param_rows(params, param, values)
     init = new_state(x0, v0)
-    opts = solver.opts()
-    tol = settle_tolerance(solver, settle)
     fresh = list(directions) == ["fresh"]
     if fresh:
         # every value is its own one-point branch, all in parallel
@@ -120,38 +213,10 @@ def run_branches(params: Params, param: str, values, solver: Solver, *, directio
         orders = [np.arange(nv)]
     else:
         orders = [np.arange(nv) if d == "up" else np.arange(nv)[::-1] for d in directions]
-        P = np.stack([rows[o] for o in orders])  # (branch, value in sweep order, 7)
-    nbr, nval = P.shape[0], P.shape[1]
-    states = np.tile(init, (nbr, 1))
-    X = np.empty((nbr, nval, record))
-    V = np.empty_like(X)
-    R = np.empty((nbr, nval, record), np.int8)
-    M = np.empty((nbr, nval, record), np.uint8)
-    Xmax = np.empty_like(X)
-    Xmin = np.empty_like(X)
-    status = np.zeros((nbr, nval), np.int64)
-    used = np.zeros((nbr, nval), np.int64)
-    S = np.empty((nbr, nval, init.size))
-    with threads(workers):
-        if fresh:
-            step = max(chunk, 1) * 4
-            for a in range(0, nbr, step):
-                b = min(nbr, a + step)
-                continuation(solver.code, P[a:b], opts, states[a:b], init, transient, tol,
-                             X[a:b], V[a:b], R[a:b], M[a:b], Xmax[a:b], Xmin[a:b],
-                             status[a:b], used[a:b], S[a:b])
-                if progress is not None:
-                    progress(b, nbr)
-        else:
-            for a in range(0, nval, chunk):
-                b = min(nval, a + chunk)
-                continuation(solver.code, P[:, a:b], opts, states, init, transient, tol,
-                             X[:, a:b], V[:, a:b], R[:, a:b], M[:, a:b], Xmax[:, a:b],
-                             Xmin[:, a:b], status[:, a:b], used[:, a:b], S[:, a:b])
-                if progress is not None:
-                    progress(b, nval)
-    out = {"X": X, "V": V, "R": R, "M": M, "Xmax": Xmax, "Xmin": Xmin, "status": status,
-           "used": used, "S": S}
+        P = np.ascontiguousarray(np.stack([rows[o] for o in orders]))  # (branch, value, 7)
+    states = np.tile(init, (P.shape[0], 1))
+    out = follow(P, solver, states, init, transient, settle_tolerance(solver, settle), record,
+                 workers=workers, progress=progress, group=4 * chunk if fresh else None)
     if fresh:
         out = {k: np.moveaxis(a, 0, 1) for k, a in out.items()}  # (1, value, ...)
     else:
@@ -161,19 +226,58 @@ def run_branches(params: Params, param: str, values, solver: Solver, *, directio
     return out
 
 
-def summarize(out, rtol: float, atol: float):
-    """period, max_X, min_X, contact per (branch, value)."""
+#: A section that is still converging (``periodicity.still_converging``) is integrated
+#: further, from the end of its recorded window, by about 1.5 x the number of periods it is
+#: estimated to need (rounded up to a power of 2, at least ``record``; ended early once settled,
+#: ``poincare.settle``; points of equal extension run in parallel) and recorded again, in
+#: at most MAX_ROUNDS rounds and MAX_EXTENSION x max(transient, record) periods in all; what is
+#: still undecided then is labelled NOT_SETTLED (period -1). Sections that do not converge
+#: (chaos) are never extended.
+MAX_EXTENSION = 20
+MAX_ROUNDS = 3
+
+
+def summarize(out, rows, solver: Solver, transient: int, record: int, workers=None):
+    """period, max_X, min_X, contact per (branch, value) of ``out`` (ascending value order,
+    ``rows[i]`` the packed parameters of value i). Sections still converging are extended
+    first (see MAX_EXTENSION): their data in ``out`` (X ... Xmin, ``used``: the periods
+    before the recorded window, ``S``) are replaced by the later window."""
     shape = out["status"].shape
     period = np.zeros(shape, np.int64)
     mx = np.full(shape, np.nan)
     mn = np.full(shape, np.nan)
     contact = np.zeros(shape, np.int8)
-    for j in range(shape[0]):
-        for i in range(shape[1]):
-            if out["status"][j, i] == st.OK:
-                period[j, i], mx[j, i], mn[j, i], contact[j, i] = classify(
-                    out["X"][j, i], out["V"][j, i], out["Xmax"][j, i], out["Xmin"][j, i],
-                    out["M"][j, i], rtol, atol)
+    cap = MAX_EXTENSION * max(transient, record)
+    extra = np.zeros(shape, np.int64)
+    todo = [(j, i) for j in range(shape[0]) for i in range(shape[1])
+            if out["status"][j, i] == st.OK]
+    for rnd in range(MAX_ROUNDS + 1):
+        pending = {}  # extension (a power of 2 periods, at least ``record``) -> points
+        for j, i in todo:
+            period[j, i], mx[j, i], mn[j, i], contact[j, i], need = classify(
+                out["X"][j, i], out["V"][j, i], out["Xmax"][j, i], out["Xmin"][j, i],
+                out["M"][j, i], solver.rtol, solver.atol)
+            if need > 0 and rnd < MAX_ROUNDS and extra[j, i] + record + need <= cap:
+                ext = max(record, 1 << int(math.ceil(math.log2(1.5 * need))))
+                ext = min(ext, cap - int(extra[j, i]) - record)
+                pending.setdefault(ext, []).append((j, i))
+        for ext, points in pending.items():
+            idx = tuple(np.array(points).T)
+            states = out["S"][idx].copy()
+            res = follow(np.ascontiguousarray(rows[idx[1]][:, None, :]), solver, states,
+                         states[0].copy(), ext, settle_tolerance(solver, True), record,
+                         workers=workers)
+            for k, (j, i) in enumerate(points):
+                out["status"][j, i] = res["status"][k, 0]
+                for key in ("X", "V", "R", "M", "Xmax", "Xmin", "S"):
+                    out[key][j, i] = res[key][k, 0]
+                out["used"][j, i] += record + res["used"][k, 0]
+                extra[j, i] += record + res["used"][k, 0]
+        todo = [q for points in pending.values() for q in points]
+        if not todo:
+            break
+    failed = out["status"] != st.OK
+    period[failed], contact[failed], mx[failed], mn[failed] = 0, 0, np.nan, np.nan
     return period, mx, mn, contact
 
 
@@ -192,9 +296,15 @@ def bifurcation_diagram(params: Params, param: str, values, *, sweep: str = "bot
     (x0, v0). Each value: ``transient`` periods (ended early once the section has provably
     settled when ``settle=True``, see ``analysis.poincare``), then ``record`` section points.
 
-    Returns a Dataset with coordinates ``<param>`` and ``sweep`` and variables ``X``, ``V``
-    (sweep, <param>, n), ``period`` (0 = not periodic), ``max_X``, ``min_X``, ``contact``,
-    ``status`` (0 = ok; failed points have NaN data) and ``transient_used``.
+    A section still converging to a periodic orbit after that is integrated further before it
+    is classified (``MAX_EXTENSION``); chaotic sections are not.
+
+    Returns a Dataset with coordinates ``<param>`` and ``sweep`` (integer codes with CF
+    flag_values/flag_meanings, ``SWEEP_CODES``; names by ``plot.bifurcation.sweep_names``) and variables
+    ``X``, ``V`` (sweep, <param>, n), ``period`` (0 = not periodic, -1 = not settled),
+    ``max_X``, ``min_X``, ``contact``, ``status`` (0 = ok; failed points have NaN data) and
+    ``transient_used`` (periods before the recorded window). The swept parameter is not in
+    the attrs (``param_<param>`` is dropped).
     ``max_steps``: integration steps allowed per forcing period (see ``kernels.Solver``).
     """
     from ..simulate import check_float, check_int, check_params
@@ -202,11 +312,12 @@ def bifurcation_diagram(params: Params, param: str, values, *, sweep: str = "bot
     if not isinstance(param, str):
         raise ParameterError(f"param: expected a parameter name, got {param!r}")
     param = check_param_name(param)
-    values = check_values(param, values)
     if sweep not in SWEEPS:
         raise ParameterError(f"sweep: unknown sweep {sweep!r} (known: {', '.join(SWEEPS)})")
     transient = check_int("transient", transient, 0)
     record = check_int("record", record, 1)
+    check_sweep_memory(np.size(values), 2 if sweep == "both" else 1, record)
+    values = check_values(param, values)
     x0 = check_float("x0", x0)
     v0 = check_float("v0", v0)
     solver = Solver(method=method, rtol=rtol, atol=atol, transition=transition,
@@ -217,11 +328,20 @@ def bifurcation_diagram(params: Params, param: str, values, *, sweep: str = "bot
                        workers=workers, progress=progress)
     return branches_dataset(params, param, values, solver, directions, out,
                             analysis="bifurcation", transient=transient, record=record,
-                            x0=x0, v0=v0, settle=settle, sweep_mode=sweep)
+                            x0=x0, v0=v0, settle=settle, sweep_mode=sweep, workers=workers)
 
 
-def branches_dataset(params, param, values, solver, directions, out, **attrs) -> xr.Dataset:
-    period, mx, mn, contact = summarize(out, solver.rtol, solver.atol)
+#: Integer codes of the ``sweep`` coordinate (CF flag_values / flag_meanings).
+SWEEP_CODES = {"up": 0, "down": 1, "fresh": 2}
+
+
+def branches_dataset(params, param, values, solver, directions, out, *, workers=None,
+                     **attrs) -> xr.Dataset:
+    """The Dataset of :func:`run_branches` output (classified by :func:`summarize`)."""
+    from ..io import flag_attrs, status_flags
+    rows = param_rows(params, param, values)
+    period, mx, mn, contact = summarize(out, rows, solver, attrs["transient"], attrs["record"],
+                                        workers)
     desc, unit, _ = PARAM_INFO[param]
     dims = ("sweep", param)
     nfail = int(np.count_nonzero(out["status"]))
@@ -231,26 +351,29 @@ def branches_dataset(params, param, values, solver, directions, out, **attrs) ->
                                             "units": "1"}),
             "V": (dims + ("n",), out["V"], {"long_name": "section velocity dX/dt(kT)",
                                             "units": "1/s"}),
-            "period": (dims, period, {"long_name": "period of the section (0 = not periodic)"}),
+            "period": (dims, period, {"long_name": PERIOD_LONG_NAME, "units": "1"}),
             "max_X": (dims, mx, {"long_name": "largest X over the recorded periods",
                                  "units": "1"}),
             "min_X": (dims, mn, {"long_name": "smallest X over the recorded periods",
                                  "units": "1"}),
-            "contact": (dims, contact, {"long_name": "contact with the support (0/1)"}),
-            "status": (dims, out["status"],
-                       {"long_name": "kernel status (0 = ok)",
-                        "legend": ", ".join(f"{k}: {v}" for k, v in st.MESSAGES.items())}),
-            "transient_used": (dims, out["used"],
-                               {"long_name": "transient periods integrated"}),
+            "contact": (dims, contact, flag_attrs(("no_contact", "contact"), dtype=np.int8,
+                                                  long_name="contact with the support")),
+            "status": (dims, out["status"], status_flags(long_name="kernel status")),
+            "transient_used": (dims, out["used"], {
+                "long_name": "forcing periods integrated before the recorded window",
+                "units": "1"}),
         },
         coords={
             param: (param, values, {"long_name": desc, "units": unit}),
-            "sweep": ("sweep", np.array(directions, dtype=object),
-                      {"long_name": "continuation direction (fresh = restart each value)"}),
+            "sweep": ("sweep", np.array([SWEEP_CODES[d] for d in directions], np.int8),
+                      flag_attrs(list(SWEEP_CODES), dtype=np.int8,
+                                 long_name="continuation direction (fresh = restart each "
+                                           "value)")),
             "n": ("n", np.arange(out["X"].shape[2]), {"long_name": "section index"}),
         },
         attrs=provenance_attrs(params, solver, param=param, max_period=MAX_PERIOD,
                                n_failed=nfail, **attrs),
     )
-    ds.attrs["swept_param"] = param  # param_<param> holds the base value (not swept)
+    ds.attrs["swept_param"] = param
+    del ds.attrs[f"param_{param}"]  # swept: a coordinate, not a single value
     return ds

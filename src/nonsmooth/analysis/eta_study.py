@@ -3,8 +3,8 @@ non-smooth dynamics (the paper's Fig. 4 question, answered against the eta = 0 s
 
 ``eta_study(params, etas)`` integrates, from the same initial state, the smoothed model
 (``method="smooth"``) for every eta and the exact event-driven model (``method="exact"``)
-once, discards ``transient`` forcing periods and records ``points`` stroboscopic section points
-(t = kT, forcing phase 0) plus a phase portrait of ``portrait_periods`` periods.
+once, discards ``transient`` forcing periods and records ``record`` stroboscopic section points
+(t = kT, forcing phase 0) plus an orbit (phase portrait) of ``orbit_periods`` periods.
 
 Per eta (dimension ``eta``):
 
@@ -24,8 +24,8 @@ Per eta (dimension ``eta``):
   samples of the same chaotic attractor agree);
 * ``status``: kernel status (0 = ok); a failed trajectory gets NaN, period 0 and agrees 0.
 
-Attribute ``recommended_eta``: the largest eta that agrees with the exact model (NaN if none).
-The exact orbit's section, portrait, period and contact flag are stored as ``exact_*``.
+Variable ``recommended_eta``: the largest eta that agrees with the exact model (NaN if none).
+The exact orbit's section, orbit, period and contact flag are stored as ``exact_*``.
 """
 
 from __future__ import annotations
@@ -38,7 +38,7 @@ import xarray as xr
 from ..errors import ParameterError
 from ..io import provenance_attrs
 from ..kernels import Solver, new_state
-from ..models.switch import GAMMA_PLUS, REGION_LEGEND
+from ..models.switch import GAMMA_PLUS
 from ..params import Params
 from ..sweep import run_trajectories
 from .periodicity import detect_period, section_tolerance
@@ -96,33 +96,57 @@ def _period(X, V, rtol, atol) -> int:
                              section_tolerance(rtol, atol, scale), MAX_PERIOD))
 
 
-def _integrate(P, solver, x0, v0, transient, points, portrait_periods, spp, workers):
-    """Section (per period) and portrait (spp per period) of each row of P."""
+def _integrate(P, solver, x0, v0, transient, record, orbit_periods, spp, workers, progress):
+    """Section (per period) and orbit (spp per period) of each row of P."""
     n = P.shape[0]
     states = np.tile(new_state(x0, v0), (n, 1))
-    sec = run_trajectories(P, solver, states, per_period=1, n_skip=transient, n_out=points,
-                           workers=workers)
+    sec = run_trajectories(P, solver, states, per_period=1, n_skip=transient, n_out=record,
+                           workers=workers, progress=progress(0))
     por = run_trajectories(P, solver, sec["state"], per_period=spp, n_skip=0,
-                           n_out=portrait_periods * spp, workers=workers)
+                           n_out=orbit_periods * spp, workers=workers,
+                           progress=progress(n * (transient + record)))
     status = np.where(sec["status"] != 0, sec["status"], por["status"])
     return sec, por, status
 
 
-def eta_study(params: Params, etas, *, transient: int = 300, points: int = 200,
-              portrait_periods: int = 10, samples_per_period: int = 200, x0: float = 0.0,
+def eta_study(params: Params, etas, *, transient: int = 300, record: int | None = None,
+              orbit_periods: int | None = None, samples_per_period: int = 200, x0: float = 0.0,
               v0: float = 0.0, rtol: float = 1e-8, atol: float = 1e-10,
               distance_tol: float = 1e-3, transition: str = "eq13",
-              workers: int | None = None) -> xr.Dataset:
+              workers: int | None = None, progress=None, points: int | None = None,
+              portrait_periods: int | None = None) -> xr.Dataset:
     """Audit the band half-width eta of the smoothed model against the exact model.
 
-    See the module documentation for the variables and the agreement criterion.
+    From (x0, v0), every eta (smoothed model) and the exact model integrate ``transient``
+    forcing periods, record ``record`` (default 200; ``points`` is its deprecated name)
+    section points and then an orbit of ``orbit_periods`` (default 10; deprecated name
+    ``portrait_periods``) periods at ``samples_per_period`` samples per period.
+    ``progress(done, total)`` is called between time slices.
+
+    Returns an ``xarray.Dataset`` over ``eta`` (and ``n`` for section points, time
+    ``t_section``; ``sample`` for orbit samples, time ``orbit_t``) with
+
+    * ``reaches_gamma_plus``, ``period``, ``distance_to_exact``, ``agrees``, ``status``,
+      ``regions_visited`` (definitions in the module documentation);
+    * ``section_X``, ``section_V`` (eta, n), ``orbit_X``, ``orbit_V``, ``orbit_region``,
+      ``orbit_visited`` (eta, sample);
+    * the exact model's ``exact_section_X/V``, ``exact_orbit_X/V/region`` and the scalars
+      ``exact_period``, ``exact_reaches_gamma_plus``, ``exact_status``,
+      ``exact_self_distance``;
+    * ``recommended_eta``: the largest eta that agrees with the exact model (NaN if none).
     """
+    from ..io import check_memory, flag_attrs, status_flags
+    from ..models.switch import REGION_NAMES
+    from ..simulate import renamed
     if not isinstance(params, Params):
         raise ParameterError(f"params: expected nonsmooth.Params, got {type(params).__name__}")
     eta_vals = check_etas(etas)
+    record = renamed("record", record, "points", points, default=200)
+    orbit_periods = renamed("orbit_periods", orbit_periods, "portrait_periods",
+                            portrait_periods, default=10)
     transient = _check_count("transient", transient, 0)
-    points = _check_count("points", points, 2)
-    portrait_periods = _check_count("portrait_periods", portrait_periods, 1)
+    record = _check_count("record", record, 2)
+    orbit_periods = _check_count("orbit_periods", orbit_periods, 1)
     spp = _check_count("samples_per_period", samples_per_period, 1)
     for name, v in (("x0", x0), ("v0", v0), ("distance_tol", distance_tol)):
         if isinstance(v, bool) or not isinstance(v, (int, float, np.floating, np.integer)) \
@@ -130,14 +154,24 @@ def eta_study(params: Params, etas, *, transient: int = 300, points: int = 200,
             raise ParameterError(f"{name}: expected a finite number, got {v!r}")
     if distance_tol < 0:
         raise ParameterError(f"distance_tol: must be >= 0, got {distance_tol}")
+    n = len(eta_vals)
+    check_memory(34.0 * (n + 1) * (record + orbit_periods * spp), "record",
+                 "record fewer section points, orbit periods or samples per period")
     smooth = Solver(method="smooth", rtol=rtol, atol=atol, transition=transition)
     exact = Solver(method="exact")
 
+    total = (n + 1) * (transient + record + orbit_periods)
+
+    def stage(offset):
+        return None if progress is None else (lambda d, _t: progress(offset + d, total))
+
     P = np.stack([params.replace(eta=float(e)).pack() for e in eta_vals])
-    sec, por, status = _integrate(P, smooth, float(x0), float(v0), transient, points,
-                                  portrait_periods, spp, workers)
+    sec, por, status = _integrate(P, smooth, float(x0), float(v0), transient, record,
+                                  orbit_periods, spp, workers, stage)
+    done = n * (transient + record + orbit_periods)
     esec, epor, estatus = _integrate(params.pack()[None, :], exact, float(x0), float(v0),
-                                     transient, points, portrait_periods, spp, workers)
+                                     transient, record, orbit_periods, spp, workers,
+                                     lambda o: stage(done + o))
     om = params.omega
 
     # ---- exact reference ----
@@ -145,13 +179,12 @@ def eta_study(params: Params, etas, *, transient: int = 300, points: int = 200,
     e_ok = int(estatus[0]) == 0
     e_contact = int(bool(np.any(esec["M"][0] & (1 << GAMMA_PLUS)))) if e_ok else 0
     e_period = _period(eX, eV, EXACT_RTOL, EXACT_ATOL) if e_ok else 0
-    h = points // 2
+    h = record // 2
     e_self = set_distance(eX[:h], eV[:h] / om, eX[h:], eV[h:] / om) if e_ok else float("nan")
     if e_period > 0:
         e_self = 0.0
 
     # ---- per eta ----
-    n = len(eta_vals)
     reach = np.zeros(n, np.int8)
     period = np.zeros(n, np.int64)
     dist = np.full(n, np.nan)
@@ -171,58 +204,79 @@ def eta_study(params: Params, etas, *, transient: int = 300, points: int = 200,
     good = eta_vals[agrees == 1]
     recommended = float(good.max()) if good.size else float("nan")
 
-    t_sec = (transient + np.arange(1, points + 1)) * params.period
+    T = params.period
+    t_sec = (transient + np.arange(1, record + 1)) * T
+    t_orb = (transient + record) * T + np.arange(1, orbit_periods * spp + 1) * (T / spp)
+    regions = flag_attrs(REGION_NAMES, dtype=np.int8)
+    masks = flag_attrs(REGION_NAMES, dtype=np.uint8, masks=True)
+    yes_no = flag_attrs(("no", "yes"), dtype=np.int8)
+    period_attrs = {"long_name": "period of the section points in forcing periods "
+                                 "(0 = none)", "units": "1"}
     ds = xr.Dataset(
         {
-            "reaches_gamma_plus": ("eta", reach, {
-                "long_name": "settled smoothed orbit enters Gamma+ (1) or not (0)"}),
-            "period": ("eta", period, {"long_name": "period of the section points (0 = none)",
-                                       "units": "forcing periods"}),
+            "reaches_gamma_plus": ("eta", reach, dict(
+                yes_no, long_name="settled smoothed orbit enters Gamma+")),
+            "period": ("eta", period, period_attrs),
             "distance_to_exact": ("eta", dist, {
                 "long_name": "symmetric mean nearest-neighbour distance of the section points "
-                             "to the exact ones in (X, V/omega)", "units": "1 (gap)"}),
-            "agrees": ("eta", agrees, {"long_name": "same contact, same period and distance "
-                                                    "within tolerance (1) or not (0)"}),
-            "regions_visited": ("eta", visited, {
-                "long_name": "regions visited during the recorded periods",
-                "legend": "bit mask, bit r set = region code r visited; " + REGION_LEGEND}),
-            "status": ("eta", np.asarray(status, np.int64), {"long_name": "kernel status (0 = ok)"}),
-            "section_X": (("eta", "n"), sec["X"], {"long_name": "X at t = kT", "units": "1"}),
-            "section_V": (("eta", "n"), sec["V"], {"long_name": "V at t = kT", "units": "1/s"}),
-            "portrait_X": (("eta", "sample"), por["X"], {"long_name": "X", "units": "1"}),
-            "portrait_V": (("eta", "sample"), por["V"], {"long_name": "V", "units": "1/s"}),
-            "portrait_region": (("eta", "sample"), por["R"], {
-                "long_name": "region at the sample", "legend": REGION_LEGEND}),
-            "portrait_visited": (("eta", "sample"), por["M"], {
-                "long_name": "regions visited since the previous sample",
-                "legend": "bit mask, bit r set = region code r visited"}),
-            "exact_section_X": ("n", eX, {"long_name": "exact model: X at t = kT", "units": "1"}),
-            "exact_section_V": ("n", eV, {"long_name": "exact model: V at t = kT",
+                             "to the exact ones in (X, V/omega), in units of the gap",
+                "units": "1"}),
+            "agrees": ("eta", agrees, dict(
+                yes_no, long_name="same contact, same period and distance within tolerance")),
+            "regions_visited": ("eta", visited, dict(
+                masks, long_name="regions visited during the recorded periods")),
+            "status": ("eta", np.asarray(status, np.int64), status_flags(
+                long_name="kernel status")),
+            "section_X": (("eta", "n"), sec["X"], {"long_name": "X at t_section", "units": "1"}),
+            "section_V": (("eta", "n"), sec["V"], {"long_name": "V at t_section",
+                                                   "units": "1/s"}),
+            "orbit_X": (("eta", "sample"), por["X"], {"long_name": "X", "units": "1"}),
+            "orbit_V": (("eta", "sample"), por["V"], {"long_name": "V", "units": "1/s"}),
+            "orbit_region": (("eta", "sample"), por["R"], dict(
+                regions, long_name="region at the sample")),
+            "orbit_visited": (("eta", "sample"), por["M"], dict(
+                masks, long_name="regions visited since the previous sample")),
+            "exact_section_X": ("n", eX, {"long_name": "exact model: X at t_section",
+                                          "units": "1"}),
+            "exact_section_V": ("n", eV, {"long_name": "exact model: V at t_section",
                                           "units": "1/s"}),
-            "exact_portrait_X": ("sample", epor["X"][0], {"long_name": "exact model: X",
-                                                          "units": "1"}),
-            "exact_portrait_V": ("sample", epor["V"][0], {"long_name": "exact model: V",
-                                                          "units": "1/s"}),
-            "exact_portrait_region": ("sample", epor["R"][0], {
-                "long_name": "exact model: mode at the sample (0 free flight, 3 contact)"}),
+            "exact_orbit_X": ("sample", epor["X"][0], {"long_name": "exact model: X",
+                                                      "units": "1"}),
+            "exact_orbit_V": ("sample", epor["V"][0], {"long_name": "exact model: V",
+                                                      "units": "1/s"}),
+            "exact_orbit_region": ("sample", epor["R"][0], dict(
+                regions, long_name="exact model: mode at the sample (Gamma_minus free "
+                                   "flight, Gamma_plus contact)")),
+            "exact_period": ((), np.int64(e_period), dict(period_attrs, long_name=(
+                "exact model: " + period_attrs["long_name"]))),
+            "exact_reaches_gamma_plus": ((), np.int8(e_contact), dict(
+                yes_no, long_name="exact model: the orbit reaches the support")),
+            "exact_status": ((), np.int64(estatus[0]), status_flags(
+                long_name="exact model: kernel status")),
+            "exact_self_distance": ((), float(e_self), {
+                "long_name": "distance between the two halves of the exact section points",
+                "units": "1"}),
+            "recommended_eta": ((), recommended, {
+                "long_name": "largest eta that agrees with the exact model (NaN: none)",
+                "units": "1"}),
         },
         coords={
             "eta": ("eta", eta_vals, {"long_name": "band half-width eta (eq. 14)", "units": "1"}),
-            "n": ("n", np.arange(points), {"long_name": "section point index"}),
-            "sample": ("sample", np.arange(portrait_periods * spp),
-                       {"long_name": "portrait sample index"}),
+            "n": ("n", np.arange(record), {"long_name": "section point index"}),
+            "sample": ("sample", np.arange(orbit_periods * spp),
+                       {"long_name": "orbit sample index"}),
             "t_section": ("n", t_sec, {"long_name": "time of the section point", "units": "s"}),
+            "orbit_t": ("sample", t_orb, {"long_name": "time of the orbit sample",
+                                          "units": "s"}),
         },
         attrs=provenance_attrs(
-            params, smooth, analysis="eta_study", transient=transient, points=points,
-            portrait_periods=portrait_periods, samples_per_period=spp, x0=float(x0),
+            params, smooth, analysis="eta_study", transient=transient, record=record,
+            orbit_periods=orbit_periods, samples_per_period=spp, x0=float(x0),
             v0=float(v0), distance_tol=float(distance_tol),
             distance_definition="symmetric mean nearest-neighbour distance in (X, V/omega)",
             agreement_rule="reaches_gamma_plus and period equal to the exact model's and "
                            "distance_to_exact <= distance_tol + 2 exact_self_distance",
-            recommended_eta=recommended, exact_status=int(estatus[0]),
-            exact_period=int(e_period), exact_reaches_gamma_plus=int(e_contact),
-            exact_self_distance=float(e_self), exact_method="exact",
-            forcing_period=params.period, region_legend=REGION_LEGEND),
+            exact_method="exact", forcing_period=T),
     )
+    del ds.attrs["param_eta"]  # swept: the coordinate eta
     return ds

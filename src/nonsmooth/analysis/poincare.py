@@ -1,16 +1,26 @@
 """Stroboscopic Poincaré map (section t = kT) with period classification and a phase portrait.
 
-``poincare(params, ...)`` is the convenience call; the compiled per-point core
-:func:`settle_and_record` (transient, optionally ended early once provably settled, then the
-recorded section) is shared with the bifurcation and resonance sweeps.
+``poincare(params, ...)`` is the convenience call; it runs one point of the sweeps' resumable
+continuation core (``bifurcation.continuation`` driven by ``bifurcation.follow``: the
+transient of :func:`settle`, optionally ended early once provably settled, then the recorded
+section, in time slices so that Ctrl-C and progress work inside one trajectory), and classifies
+the section like the bifurcation and resonance sweeps (``bifurcation.summarize``).
 
 Definitions
 -----------
-* Section: the state (X, V) at t = kT, k = transient + 1 ... transient + points (forcing phase 0).
+* Section: the state (X, V) at t_section = kT, k = transient + 1 ... transient + record
+  (forcing phase 0).
 * ``period``: the smallest p <= 64 such that every recorded section point repeats after p
   periods within ``section_tolerance(rtol, atol, scale)`` (scale = largest |X|, |V| seen), i.e.
-  1e3 times the integration tolerance; 0 = no repetition (chaotic, quasi-periodic or not yet
-  settled). At least 2 p points are needed to accept period p.
+  1e3 times the integration tolerance. At least 2 p points are needed to accept period p.
+  A period is never reported from a section that is still converging: when the repetition
+  defects of no period, or of a smaller period q dividing p, still decay geometrically
+  (``periodicity.still_converging``), the trajectory is integrated further, by the number of
+  periods the observed decay rate needs, and recorded again (``bifurcation.MAX_EXTENSION``:
+  at most 20 x max(transient, record) periods in all); if that is not enough, the period is
+  -1 (``NOT_SETTLED``, "not settled"). 0 = no repetition and no convergence seen (chaotic,
+  quasi-periodic, or a transient that still looks chaotic at the end of the window); chaotic
+  sections are never extended.
 * ``max_X``, ``min_X``: the true extremes of X over the recorded periods (interior extrema
   included, from the kernels' per-interval Xmax/Xmin), not only the section values.
 * ``contact``: 1 when, during the recorded periods, the trajectory left the free-flight region
@@ -44,13 +54,15 @@ from .. import status as st
 from ..errors import IntegrationError
 from ..integrate.contract import ST_MODE
 from ..io import provenance_attrs
-from ..kernels import Solver, advance, output_buffers
-from ..models.switch import REGION_LEGEND
+from ..kernels import Solver, advance
 from ..params import Params
-from .periodicity import detect_period, section_tolerance
+from .periodicity import NOT_SETTLED, detect_period, section_tolerance, still_converging
 
 #: Largest period the period detection looks for.
 MAX_PERIOD = 64
+#: long_name of every ``period`` variable.
+PERIOD_LONG_NAME = ("period of the section in forcing periods (0 = not periodic, -1 = not "
+                    "settled: still converging after the longest transient allowed)")
 #: Periods per settle test window, and the largest period the settle test recognises.
 SETTLE_WINDOW = 24
 SETTLE_MAX_PERIOD = 8
@@ -94,15 +106,19 @@ def _settled(X, V, tol, pmax):
 
 
 @nb.njit(cache=True)
-def settle(method, p, opts, state, transient, settle_tol):
-    """Integrate up to ``transient`` forcing periods from a period boundary, updating ``state``.
-    ``settle_tol > 0`` ends early once settled (module docstring; the scale of the tolerance
-    is the largest |X|, |V| in the window). Returns (status, periods integrated)."""
+def settle(method, p, opts, state, transient, settle_tol, done, budget):
+    """Continue a transient of ``transient`` forcing periods of which ``done`` are integrated
+    (``state`` is updated), for about ``budget`` more periods: whole settle windows (at least
+    one), so that a transient cut into such calls is identical to one call. ``settle_tol > 0``
+    ends the transient early once settled (module docstring; the scale of the tolerance is the
+    largest |X|, |V| in the window). Returns (status, periods done, finished)."""
     if settle_tol <= 0.0 or transient < SETTLE_WINDOW:
+        n = max(0, min(budget, transient - done))
         e0 = np.empty(0)
-        code = advance(method, p, opts, state, 1, transient, 0, e0, e0, np.empty(0, np.int8),
+        code = advance(method, p, opts, state, 1, n, 0, e0, e0, np.empty(0, np.int8),
                        np.empty(0, np.uint8), e0, e0)
-        return code, transient
+        done += n
+        return code, done, code != 0 or done >= transient
     w = SETTLE_WINDOW
     bx = np.empty(w)
     bv = np.empty(w)
@@ -110,40 +126,21 @@ def settle(method, p, opts, state, transient, settle_tol):
     bm = np.empty(w, np.uint8)
     b1 = np.empty(w)
     b2 = np.empty(w)
-    done = 0
-    while done < transient:
+    start = done
+    while done < transient and (done == start or done - start < budget):
         n = min(w, transient - done)
         code = advance(method, p, opts, state, 1, 0, n, bx[:n], bv[:n], br[:n], bm[:n],
                        b1[:n], b2[:n])
         done += n
         if code != 0:
-            return code, done
+            return code, done, True
         if n == w:
             scale = 1.0
             for k in range(w):
                 scale = max(scale, abs(bx[k]), abs(bv[k]))
             if _settled(bx, bv, settle_tol * scale, SETTLE_MAX_PERIOD):
-                break
-    return 0, done
-
-
-@nb.njit(cache=True)
-def settle_and_record(method, p, opts, state, transient, settle_tol, X, V, R, M, Xmax, Xmin):
-    """Per-point core: :func:`settle` over the transient, then record ``len(X)`` section points
-    (one per forcing period, kernel contract outputs). Returns (status, transient periods used).
-    On failure the outputs are NaN."""
-    code, used = settle(method, p, opts, state, transient, settle_tol)
-    if code == 0:
-        code = advance(method, p, opts, state, 1, 0, X.shape[0], X, V, R, M, Xmax, Xmin)
-    if code != 0:
-        for k in range(X.shape[0]):
-            X[k] = np.nan
-            V[k] = np.nan
-            Xmax[k] = np.nan
-            Xmin[k] = np.nan
-            R[k] = -1
-            M[k] = 0
-    return code, used
+                return 0, done, True
+    return 0, done, done >= transient
 
 
 def settle_tolerance(solver: Solver, settle: bool) -> float:
@@ -152,87 +149,118 @@ def settle_tolerance(solver: Solver, settle: bool) -> float:
 
 
 def classify(X, V, Xmax, Xmin, M, rtol: float, atol: float, max_period: int = MAX_PERIOD):
-    """(period, max_X, min_X, contact) of recorded section data (see module docstring).
-    NaN data give (0, nan, nan, 0)."""
+    """(period, max_X, min_X, contact, need) of recorded section data (see module docstring).
+    ``need`` > 0: the section is still converging (``periodicity.still_converging``), period
+    is then NOT_SETTLED and ``need`` estimates the further periods it takes to settle.
+    NaN data give (0, nan, nan, 0, 0)."""
     X = np.ascontiguousarray(X, dtype=np.float64)
     V = np.ascontiguousarray(V, dtype=np.float64)
     if X.size == 0 or not (np.all(np.isfinite(X)) and np.all(np.isfinite(V))):
-        return 0, float("nan"), float("nan"), 0
+        return 0, float("nan"), float("nan"), 0, 0.0
     scale = float(max(np.max(np.abs(X)), np.max(np.abs(V))))
-    period = int(detect_period(X, V, section_tolerance(rtol, atol, scale), max_period))
+    tol = section_tolerance(rtol, atol, scale)
+    period = int(detect_period(X, V, tol, max_period))
+    need = float(still_converging(X, V, tol, period, max_period))
+    if need > 0:
+        period = NOT_SETTLED
     mx = float(np.max(Xmax))
     mn = float(np.min(Xmin))
     contact = int(bool(np.any(np.asarray(M) & np.uint8(0b1110))) and mx >= 1.0)
-    return period, mx, mn, contact
+    return period, mx, mn, contact, need
 
 
-def poincare(params: Params, *, points: int, transient: int, x0: float = 0.0, v0: float = 0.0,
-             method: str = "smooth", rtol: float = 1e-8, atol: float = 1e-10,
+def poincare(params: Params, *, record: int | None = None, transient: int, x0: float = 0.0,
+             v0: float = 0.0, method: str = "smooth", rtol: float = 1e-8, atol: float = 1e-10,
              transition: str = "eq13", orbit_samples: int = 200, orbit_periods: int | None = None,
-             settle: bool = False) -> xr.Dataset:
+             settle: bool = False, progress=None, points: int | None = None) -> xr.Dataset:
     """Stroboscopic Poincaré section of one trajectory from (x0, v0) at t = 0.
 
     Integrates ``transient`` forcing periods (all of them unless ``settle=True``), then records
-    ``points`` section points X[n], V[n] at t = (transient + n + 1) T. Attrs ``period``
-    (0 = not periodic), ``max_X``, ``min_X``, ``contact`` are defined in the module docstring.
-    After the section run, a phase-portrait trajectory ``orbit_X``, ``orbit_V``,
-    ``orbit_region`` (dimension ``sample``) covers ``orbit_periods`` further periods (default:
-    the detected period, or 20 periods when not periodic) at ``orbit_samples`` per period; it
-    starts on the last section point, so the section points lie on it.
+    ``record`` section points X[n], V[n] at t_section = (transient + n + 1) T (``points`` is
+    the deprecated name of ``record``). A section still converging to a periodic orbit is
+    integrated further before it is classified (``bifurcation.MAX_EXTENSION``); the variable
+    ``transient_used`` gives the periods before the recorded window. Scalar variables
+    ``period`` (0 = not periodic, -1 = not settled), ``max_X``, ``min_X``, ``contact`` are
+    defined in the module docstring. After the section run, a phase-portrait trajectory
+    ``orbit_X``, ``orbit_V``, ``orbit_region`` (dimension ``sample``, time ``orbit_t``) covers
+    ``orbit_periods`` further periods (default: the detected period, or 20 periods when not
+    periodic) at ``orbit_samples`` per period; it starts on the last section point, so the
+    section points lie on it. ``progress(done, total)`` is called between time slices.
 
     Raises IntegrationError if the trajectory fails (sweeps record failures instead).
     """
-    from ..simulate import check_int, start_trajectory
+    from ..io import check_memory, flag_attrs, status_flags
+    from ..models.switch import REGION_NAMES
+    from ..simulate import check_int, renamed, start_trajectory
+    from ..sweep import run_trajectories
+    from .bifurcation import follow, summarize
+    record = renamed("record", record, "points", points)
     params, solver, p, opts, state = start_trajectory(params, x0, v0, method, rtol, atol,
                                                       transition)
     x0, v0 = float(state[0]), float(state[1])
-    points = check_int("points", points, 1)
+    record = check_int("record", record, 1)
     transient = check_int("transient", transient, 0)
     orbit_samples = check_int("orbit_samples", orbit_samples, 1)
     if orbit_periods is not None:
         orbit_periods = check_int("orbit_periods", orbit_periods, 1)
-    X, V, R, M, Xmax, Xmin = output_buffers(points)
-    code, used = settle_and_record(solver.code, p, opts, state, transient,
-                                   settle_tolerance(solver, settle), X, V, R, M, Xmax, Xmin)
-    if code != st.OK:
-        raise IntegrationError(f"poincare: integration failed: {st.message(code)}")
-    period, mx, mn, contact = classify(X, V, Xmax, Xmin, M, rtol, atol)
+    check_memory(34.0 * (record + orbit_samples * (orbit_periods or 64)), "record",
+                 "record fewer section points")
+    out = follow(p[None, None, :], solver, state[None, :], state.copy(), transient,
+                 settle_tolerance(solver, settle), record, progress=progress)
+    if out["status"][0, 0] == st.OK:
+        summary = summarize(out, p[None, :], solver, transient, record)
+    if out["status"][0, 0] != st.OK:
+        raise IntegrationError(f"poincare: integration failed: {st.message(out['status'][0, 0])}")
+    period, mx, mn, contact = (a[0, 0] for a in summary)
+    used = int(out["used"][0, 0])
+    X, V = out["X"][0, 0], out["V"][0, 0]
 
     n_orb = orbit_periods or (period if period > 0 else 20)
     ns = n_orb * orbit_samples
-    oX, oV, oR, oM, _a, _b = output_buffers(ns + 1)
-    oX[0], oV[0] = state[0], state[1]
-    oR[0] = int(state[ST_MODE])
-    oM[0] = 1 << max(int(oR[0]), 0)
-    code = advance(solver.code, p, opts, state, orbit_samples, 0, ns, oX[1:], oV[1:], oR[1:],
-                   oM[1:], _a[1:], _b[1:])
-    if code != st.OK:
-        raise IntegrationError(f"poincare: orbit integration failed: {st.message(code)}")
+    state = out["S"][0, 0]
+    orb = run_trajectories(p[None, :], solver, state[None, :], per_period=orbit_samples,
+                           n_skip=0, n_out=ns, workers=1)
+    if orb["status"][0] != st.OK:
+        raise IntegrationError(f"poincare: orbit integration failed: "
+                               f"{st.message(orb['status'][0])}")
+    oX = np.concatenate([[state[0]], orb["X"][0]])
+    oV = np.concatenate([[state[1]], orb["V"][0]])
+    oR = np.concatenate([[int(state[ST_MODE])], orb["R"][0]]).astype(np.int8)
 
     T = params.period
+    regions = flag_attrs(REGION_NAMES, dtype=np.int8)
     ds = xr.Dataset(
         {
-            "X": ("n", X, {"long_name": "section displacement X(t_n)", "units": "1"}),
-            "V": ("n", V, {"long_name": "section velocity dX/dt(t_n)", "units": "1/s"}),
+            "X": ("n", X, {"long_name": "section displacement X(t_section)", "units": "1"}),
+            "V": ("n", V, {"long_name": "section velocity dX/dt(t_section)", "units": "1/s"}),
+            "period": ((), np.int64(period), {"long_name": PERIOD_LONG_NAME, "units": "1"}),
+            "max_X": ((), mx, {"long_name": "largest X over the recorded periods (interior "
+                                            "extrema included)", "units": "1"}),
+            "min_X": ((), mn, {"long_name": "smallest X over the recorded periods (interior "
+                                            "extrema included)", "units": "1"}),
+            "contact": ((), np.int8(contact), flag_attrs(
+                ("no_contact", "contact"), dtype=np.int8, long_name="contact with the support "
+                "during the recorded periods")),
+            "status": ((), np.int64(st.OK), status_flags(long_name="kernel status")),
+            "transient_used": ((), np.int64(used), {
+                "long_name": "forcing periods integrated before the recorded window",
+                "units": "1"}),
             "orbit_X": ("sample", oX, {"long_name": "phase-portrait displacement", "units": "1"}),
             "orbit_V": ("sample", oV, {"long_name": "phase-portrait velocity", "units": "1/s"}),
-            "orbit_region": ("sample", oR, {"long_name": "region of eq. 14",
-                                            "legend": REGION_LEGEND}),
+            "orbit_region": ("sample", oR, dict(regions, long_name="region of eq. 14")),
         },
         coords={
-            "n": ("n", np.arange(points), {"long_name": "section index"}),
-            "t_n": ("n", (used + 1 + np.arange(points)) * T,
-                    {"long_name": "section time", "units": "s"}),
-            "orbit_t": ("sample", (used + points) * T + np.arange(ns + 1) * (T / orbit_samples),
+            "n": ("n", np.arange(record), {"long_name": "section index"}),
+            "t_section": ("n", (used + 1 + np.arange(record)) * T,
+                          {"long_name": "section time", "units": "s"}),
+            "orbit_t": ("sample", (used + record) * T + np.arange(ns + 1) * (T / orbit_samples),
                         {"long_name": "phase-portrait time", "units": "s"}),
         },
-        attrs=provenance_attrs(params, solver, analysis="poincare", points=points,
-                               transient=transient, transient_used=int(used), settle=settle,
-                               x0=x0, v0=v0, forcing_period=T, period=period, max_X=mx,
-                               min_X=mn, contact=contact, max_period=MAX_PERIOD,
+        attrs=provenance_attrs(params, solver, analysis="poincare", record=record,
+                               transient=transient, settle=settle, x0=x0, v0=v0,
+                               forcing_period=T, max_period=MAX_PERIOD,
                                period_tolerance=section_tolerance(
                                    rtol, atol, max(np.max(np.abs(X)), np.max(np.abs(V)))),
-                               orbit_periods=n_orb, orbit_samples=orbit_samples,
-                               region_legend=REGION_LEGEND),
+                               orbit_periods=n_orb, orbit_samples=orbit_samples),
     )
     return ds

@@ -38,7 +38,8 @@ import xarray as xr
 from ..errors import ParameterError
 from ..kernels import Solver
 from ..params import Params
-from .bifurcation import branches_dataset, check_values, continuation, run_branches
+from .bifurcation import (branches_dataset, check_sweep_memory, check_values, follow,
+                          run_branches)
 from .poincare import settle_tolerance
 
 #: During refinement a branch is continued to each bisection midpoint in steps of at most
@@ -55,7 +56,6 @@ def _continue_to(params, solver, starts, target, states, transient, record, sett
     """Continue each row of ``states`` (at frequency ``starts[row]``) quasi-statically to
     ``target`` in equal steps of at most ``ramp`` (all rows take the same number of steps).
     Returns (max_X at ``target`` per row, states there, ok)."""
-    from ..sweep import threads
     nbr = states.shape[0]
     dist = max(abs(target - w) for w in starts)
     nstep = max(1, min(MAX_RAMP_STEPS, int(math.ceil(dist / ramp - 1e-9))))
@@ -65,17 +65,9 @@ def _continue_to(params, solver, starts, target, states, transient, record, sett
         path[-1] = target
         P[b] = np.stack([params.replace(omega=float(x)).pack() for x in path])
     states = np.array(states, dtype=np.float64, copy=True)
-    X = np.empty((nbr, nstep, record))
-    V, Xmax, Xmin = np.empty_like(X), np.empty_like(X), np.empty_like(X)
-    R = np.empty(X.shape, np.int8)
-    M = np.empty(X.shape, np.uint8)
-    status = np.zeros((nbr, nstep), np.int64)
-    used = np.zeros((nbr, nstep), np.int64)
-    S = np.empty((nbr, nstep, states.shape[1]))
-    with threads(workers):
-        continuation(solver.code, P, solver.opts(), states, states[0].copy(), transient,
-                     settle_tol, X, V, R, M, Xmax, Xmin, status, used, S)
-    return Xmax[:, -1].max(axis=1), S[:, -1], bool(np.all(status == 0))
+    out = follow(P, solver, states, states[0].copy(), transient, settle_tol, record,
+                 workers=workers)
+    return out["Xmax"][:, -1].max(axis=1), out["S"][:, -1], bool(np.all(out["status"] == 0))
 
 
 def _differ(a, b, branch_tol):
@@ -179,11 +171,12 @@ def resonance_curve(params: Params, omegas, *, method: str = "smooth", transient
     (definitions in the module docstring)."""
     from ..simulate import check_float, check_int, check_params
     params = check_params(params)
+    transient = check_int("transient", transient, 0)
+    record = check_int("record", record, 1)
+    check_sweep_memory(np.size(omegas), 2, record)
     omegas = check_values("omega", omegas)
     for w in (omegas[0], omegas[-1]):
         params.replace(omega=float(w))
-    transient = check_int("transient", transient, 0)
-    record = check_int("record", record, 1)
     x0 = check_float("x0", x0)
     v0 = check_float("v0", v0)
     resolution = check_float("resolution", resolution)
@@ -202,5 +195,5 @@ def resonance_curve(params: Params, omegas, *, method: str = "smooth", transient
     ds = branches_dataset(params, "omega", omegas, solver, ["up", "down"], out,
                           analysis="resonance", transient=transient, record=record, x0=x0,
                           v0=v0, settle=settle, resolution=resolution, branch_tol=branch_tol,
-                          **freqs)
+                          workers=workers, **freqs)
     return ds

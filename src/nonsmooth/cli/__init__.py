@@ -1,14 +1,19 @@
-"""Command-line interface. ``main()`` turns user errors into one line on stderr and exit 2
-(usage errors are reported by typer itself, also with exit 2)."""
+"""Command-line interface. ``main()`` turns errors into one line on stderr and an exit status
+(README, "Exit codes"): 2 for bad input (typer's usage errors too), 3 for a numerical failure,
+130 for Ctrl-C and 143 for SIGTERM, with one line saying what was saved and what was lost."""
 
 from __future__ import annotations
 
+import os
+import signal
 import sys
 
 import typer
 
-from ..errors import NonsmoothError
-from .app import app
+from .. import _numba_cache
+from ..errors import IntegrationError, NonsmoothError
+from .app import EXIT_INTERRUPTED, EXIT_NUMERICAL, EXIT_USAGE, Interrupted, Terminated, app
+from .common import planned
 
 # Each command module registers its commands on ``app`` when imported.
 from . import simulate  # noqa: E402,F401
@@ -17,13 +22,47 @@ from . import analyses  # noqa: E402,F401
 from . import reproduce  # noqa: E402,F401
 from . import basins  # noqa: E402,F401
 
+def _terminate(signum, frame):
+    raise Terminated()
+
+
+def _compile_notice() -> None:
+    # the same rule as the progress bars (sweep.Progress): on a terminal, or when asked for
+    if os.environ.get("NONSMOOTH_PROGRESS", "") == "1" or sys.stderr.isatty():
+        typer.echo("compiling numba kernels (first run only, about a minute)...", err=True)
+
+
+def interrupted_message(code: int) -> str:
+    """What an interrupted run saved (the files written so far) and what it lost."""
+    from ..io import written_files
+
+    written = written_files()
+    untouched = [p for p in planned.values() if p not in written]
+    saved = (", ".join(map(str, written)) if len(written) <= 4 else
+             f"{len(written)} files ({written[0]} ... {written[-1]})") or "nothing"
+    lost = "the computation in progress; no partial result written"
+    if untouched:
+        lost += "; " + ", ".join(f"{p} {'untouched' if p.exists() else 'not written'}"
+                                 for p in untouched)
+    what = "interrupted" if code == EXIT_INTERRUPTED else "terminated"
+    return f"{what}: saved {saved}; lost {lost}"
+
 
 def main(argv: list[str] | None = None) -> None:
+    planned.clear()
+    previous = signal.signal(signal.SIGTERM, _terminate)
+    _numba_cache.compile_notice = _compile_notice
     try:
         app(args=argv, prog_name="nonsmooth")
+    except Interrupted as exc:
+        typer.echo(interrupted_message(exc.code), err=True)
+        sys.exit(exc.code)
+    except IntegrationError as exc:
+        typer.echo(f"error: {exc}", err=True)
+        sys.exit(EXIT_NUMERICAL)
     except NonsmoothError as exc:
         typer.echo(f"error: {exc}", err=True)
-        sys.exit(2)
-    except KeyboardInterrupt:
-        typer.echo("interrupted", err=True)
-        sys.exit(130)
+        sys.exit(EXIT_USAGE)
+    finally:  # leave a calling process (tests, a notebook) as it was
+        signal.signal(signal.SIGTERM, previous)
+        _numba_cache.compile_notice = None

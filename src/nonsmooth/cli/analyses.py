@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import math
-from typing import Annotated
+from typing import Annotated, Optional
 
 import typer
 
@@ -23,6 +23,12 @@ SettleOpt = Annotated[bool, typer.Option(
     "--settle/--no-settle", help="end the transient early once the section has provably settled")]
 
 
+
+def HiddenIntOpt(name: str):
+    """A hidden integer option: the deprecated name of another option (kept one release)."""
+    return Annotated[Optional[int], typer.Option(name, hidden=True)]
+
+
 def value_range(lo: float, hi: float, steps: int, name: str = "range"):
     """Evenly spaced values lo ... hi (validated: finite, lo < hi, steps >= 2)."""
     import numpy as np
@@ -36,6 +42,24 @@ def value_range(lo: float, hi: float, steps: int, name: str = "range"):
     return np.linspace(lo, hi, steps)
 
 
+def period_text(period: int) -> str:
+    """Words for a period code (0 = not periodic, -1 = not settled)."""
+    if period > 0:
+        return f"period {period}"
+    return "not settled (period -1)" if period < 0 else "not periodic (period 0)"
+
+
+def point_counts(ds) -> str:
+    """Counts of periodic, non-periodic, not settled and failed points of a sweep Dataset
+    (each point counted once; over all its sweeps)."""
+    per = ds.period.values
+    ok = ds.status.values == 0
+    nsw = ds.sizes["sweep"]
+    over = f"over {nsw} sweeps x {per.shape[1]} values: " if nsw > 1 else ""
+    return (f"{over}{int((ok & (per > 0)).sum())} periodic, {int((ok & (per == 0)).sum())} "
+            f"non-periodic, {int((ok & (per < 0)).sum())} not settled, {int((~ok).sum())} failed")
+
+
 def _progress(text: str):
     from ..sweep import Progress
     return Progress(text)
@@ -45,7 +69,8 @@ def _progress(text: str):
 def poincare_cmd(
     preset: PresetOpt = "table3",
     set_: SetOpt = None,
-    points: Annotated[int, typer.Option("--points", help="section points recorded")] = 2000,
+    record: Annotated[int, typer.Option("--record", help="section points recorded")] = 2000,
+    points: HiddenIntOpt("--points") = None,
     transient: TransientOpt = 500,
     x0: X0Opt = 0.0,
     v0: V0Opt = 0.0,
@@ -62,19 +87,21 @@ def poincare_cmd(
     from ..analysis.poincare import poincare
     from ..simulate import check_int
 
+    if points is not None:  # deprecated name
+        record = check_int("points", points, 1)
     params = load_params(preset, set_)
-    check_int("points", points, 1)
+    check_int("record", record, 1)
     check_int("transient", transient, 0)
     require_output(out, plot)
     check_outputs(out, plot)
-    ds = poincare(params, points=points, transient=transient, x0=x0, v0=v0, method=method,
-                  rtol=rtol, atol=atol, transition=transition, orbit_samples=orbit_samples)
+    with _progress("poincare") as prog:
+        ds = poincare(params, record=record, transient=transient, x0=x0, v0=v0, method=method,
+                      rtol=rtol, atol=atol, transition=transition, orbit_samples=orbit_samples,
+                      progress=prog)
     from ..plot.poincare import plot_poincare
     save_outputs(ds, preset, out, plot, plot_poincare)
-    a = ds.attrs
-    kind = f"period {a['period']}" if a["period"] else "not periodic (period 0)"
-    typer.echo(f"{preset}: {kind}, contact {a['contact']}, max X = {a['max_X']:.6g}, "
-               f"min X = {a['min_X']:.6g}")
+    typer.echo(f"{preset}: {period_text(int(ds.period))}, contact {int(ds.contact)}, "
+               f"max X = {float(ds.max_X):.6g}, min X = {float(ds.min_X):.6g}")
     echo_written(out, plot)
 
 
@@ -123,10 +150,8 @@ def bifurcation_cmd(
                                  workers=workers, progress=prog)
     from ..plot.bifurcation import plot_bifurcation
     save_outputs(ds, preset, out, plot, plot_bifurcation)
-    per = ds.period.values
     typer.echo(f"{preset}: {param} {from_:g} ... {to:g}, {steps} values, sweep {sweep}: "
-               f"{int((per == 0).sum())} non-periodic, {int((per > 0).sum())} periodic, "
-               f"{ds.attrs['n_failed']} failed")
+               f"{point_counts(ds)}")
     echo_written(out, plot)
 
 

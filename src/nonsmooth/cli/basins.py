@@ -33,18 +33,19 @@ def basins_cmd(
     plot: PlotOpt = None,
     orbits_plot: Annotated[Optional[Path], typer.Option("--orbits-plot", help="figure of the coexisting orbits (Fig. 8)")] = None,
 ):
-    """Basins of attraction (attractors found automatically); a Fig. 7-style image and a Fig. 8-style
-    figure of the coexisting periodic orbits."""
+    """Basins of attraction (periodic and chaotic attractors found automatically); a Fig. 7-style
+    image and a Fig. 8-style figure of the coexisting attractors."""
+    import warnings
+
     from ..analysis.basins import basins
-    from ..io import check_writable, save_figure
+    from ..io import save_figure
     from ..sweep import Progress
 
     params = load_params(preset, set_)
     require_output(out, plot if plot is not None else orbits_plot)
-    check_outputs(out, plot)
-    if orbits_plot is not None:
-        check_writable(orbits_plot, "orbits-plot")
-    with Progress("basins") as bar:
+    check_outputs(out, plot, orbits_plot=orbits_plot)
+    with Progress("basins") as bar, warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", UserWarning)
         ds = basins(params, x=x, v=v, grid=grid, method=method, transient=transient,
                     max_periods=max_periods, max_period=max_period, rtol=rtol, atol=atol,
                     transition=transition, early_stop=not no_early_stop, workers=workers,
@@ -53,12 +54,16 @@ def basins_cmd(
     save_outputs(ds, preset, out, plot, plot_basins)
     if orbits_plot is not None:
         from ..plot.basins import plot_attractors
-        save_figure(plot_attractors(ds), orbits_plot)
+        save_figure(plot_attractors(ds), orbits_plot, what="orbits-plot")
     n = ds.sizes["attractor"]
     typer.echo(f"{preset}: {ds.attrs['grid_nx']}x{ds.attrs['grid_nv']} initial conditions, "
-               f"{n} attractor(s), undecided {100 * ds.attrs['undecided_fraction']:.2f}%, "
+               f"{n} attractor(s), undecided {100 * float(ds.undecided_fraction):.2f}% "
+               f"(failed {int(ds.failed_count)}), "
                f"{ds.attrs['mean_periods_used']:.2f} periods per point on average")
     for k in range(n):
-        typer.echo(f"  A{k}: period {int(ds.period[k])}, contact {int(ds.contact[k])}, "
-                   f"max X {float(ds.max_X[k]):.6g}, fraction {float(ds.fraction[k]):.4f}")
+        kind = "chaotic" if int(ds.kind[k]) else f"period {int(ds.period[k])}"
+        typer.echo(f"  A{k}: {kind}, contact {int(ds.contact[k])}, max X {float(ds.max_X[k]):.6g}, "
+                   f"fraction {float(ds.fraction[k]):.4f}")
+    for w in caught:
+        typer.echo(f"  warning: {w.message}".replace("basins: ", ""))
     echo_written(out, plot, orbits_plot)

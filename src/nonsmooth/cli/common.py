@@ -1,4 +1,8 @@
-"""Options and helpers shared by the CLI commands (keep commands thin)."""
+"""Options and helpers shared by the CLI commands (keep commands thin).
+
+Nothing heavy is imported here (no numpy, numba, xarray or matplotlib): ``nonsmooth --help``
+only needs the options. A command imports what it computes with inside its function.
+"""
 
 from __future__ import annotations
 
@@ -8,16 +12,13 @@ from typing import Annotated, Optional
 import typer
 
 from ..errors import ParameterError
-from ..io import check_writable
-from ..kernels import Solver
-from ..params import Params, parse_assignments
-from ..presets import preset as get_preset
 
 PresetOpt = Annotated[str, typer.Option("--preset", "-p", help="parameter set (see `nonsmooth presets`)")]
 SetOpt = Annotated[Optional[list[str]], typer.Option(
     "--set", "-s", help="override a parameter, NAME=VALUE (repeatable)")]
 OutOpt = Annotated[Optional[Path], typer.Option("--out", "-o", help="netCDF result file")]
-PlotOpt = Annotated[Optional[Path], typer.Option("--plot", help="figure file (PNG, PDF, SVG)")]
+PlotOpt = Annotated[Optional[Path], typer.Option(
+    "--plot", help="figure file, format from the suffix: .png, .pdf, .svg, ... (none: PNG)")]
 MethodOpt = Annotated[str, typer.Option("--method", help="smooth (switch model, RKF45) or exact (eta = 0)")]
 RtolOpt = Annotated[float, typer.Option("--rtol", help="relative tolerance")]
 AtolOpt = Annotated[float, typer.Option("--atol", help="absolute tolerance")]
@@ -25,21 +26,28 @@ TransitionOpt = Annotated[str, typer.Option("--transition", help="eq13 (paper, d
 WorkersOpt = Annotated[Optional[int], typer.Option("--workers", "-j", help="threads (default: all cores)")]
 
 
-def load_params(preset: str, sets: list[str] | None) -> Params:
+#: Output paths this run was asked for -> the file each is written to (a figure without
+#: suffix gets ``.png``); also tells the message of an interrupted run what was not written.
+planned: dict[Path, Path] = {}
+
+
+def load_params(preset: str, sets: list[str] | None):
     """Preset with ``--set`` overrides applied (every error names the field)."""
+    from ..params import parse_assignments
+    from ..presets import preset as get_preset
     return get_preset(preset).replace(**parse_assignments(sets))
 
 
-def make_solver(method: str, rtol: float, atol: float, transition: str = "eq13") -> Solver:
-    return Solver(method=method, rtol=rtol, atol=atol, transition=transition)
+def check_outputs(out: Path | None, plot: Path | None, **figures: Path | None) -> None:
+    """Fail before computing if an output cannot be written or a figure format is unknown
+    (``figures``: further figure options, e.g. ``orbits_plot=path``, named after the option)."""
+    from ..io import check_writable, figure_path
 
-
-def check_outputs(out: Path | None, plot: Path | None) -> None:
-    """Fail before computing if an output path cannot be written."""
     if out is not None:
-        check_writable(out, "output")
-    if plot is not None:
-        check_writable(plot, "plot")
+        planned[Path(out)] = check_writable(out, "output")
+    for what, path in {"plot": plot, **figures}.items():
+        if path is not None:
+            planned[Path(path)] = figure_path(path, what.replace("_", "-"))
 
 
 def require_output(out: Path | None, plot: Path | None) -> None:
@@ -49,7 +57,7 @@ def require_output(out: Path | None, plot: Path | None) -> None:
 
 def save_outputs(ds, preset: str, out: Path | None, plot: Path | None, figure=None) -> None:
     """Record the preset, write the netCDF file and render ``figure(ds)`` (a plot function:
-    Dataset in, Figure out) to ``plot`` where asked."""
+    Dataset in, Figure out) to ``plot`` where asked (each file written atomically)."""
     from ..io import save_dataset, save_figure
 
     ds.attrs["preset"] = preset
@@ -60,6 +68,8 @@ def save_outputs(ds, preset: str, out: Path | None, plot: Path | None, figure=No
 
 
 def echo_written(*paths) -> None:
+    """Print ``wrote <file>`` for each output path asked for (None skipped), under the name
+    of the file actually written (a figure without suffix got ``.png``)."""
     for p in paths:
         if p is not None:
-            typer.echo(f"wrote {p}")
+            typer.echo(f"wrote {planned.get(Path(p), p)}")

@@ -8,6 +8,7 @@ import typer
 
 from ..errors import ParameterError
 from .app import app
+from .analyses import HiddenIntOpt, _progress
 from .common import (AtolOpt, OutOpt, PlotOpt, PresetOpt, RtolOpt, SetOpt, TransitionOpt,
                      WorkersOpt, check_outputs, echo_written, load_params, require_output,
                      save_outputs)
@@ -42,8 +43,10 @@ def eta_study_cmd(
     preset: PresetOpt = "fig4",
     set_: SetOpt = None,
     transient: Annotated[int, typer.Option(help="forcing periods discarded first")] = 300,
-    points: Annotated[int, typer.Option(help="section points (t = kT) compared")] = 200,
-    portrait_periods: Annotated[int, typer.Option(help="periods drawn in each portrait")] = 10,
+    record: Annotated[int, typer.Option(help="section points (t = kT) compared")] = 200,
+    orbit_periods: Annotated[int, typer.Option(help="periods drawn in each portrait")] = 10,
+    points: HiddenIntOpt("--points") = None,
+    portrait_periods: HiddenIntOpt("--portrait-periods") = None,
     samples_per_period: Annotated[int, typer.Option(help="portrait samples per period")] = 200,
     x0: Annotated[float, typer.Option(help="initial X")] = 0.0,
     v0: Annotated[float, typer.Option(help="initial V")] = 0.0,
@@ -64,24 +67,26 @@ def eta_study_cmd(
 
     from ..analysis.eta_study import check_etas, eta_study
 
+    record = points if points is not None else record  # deprecated names
+    orbit_periods = portrait_periods if portrait_periods is not None else orbit_periods
     etas = sorted(check_etas(parse_etas(list(eta or []) + list(more or []))), reverse=True)
     params = load_params(preset, set_)
     require_output(out, plot)
     check_outputs(out, plot)
-    ds = eta_study(params, etas, transient=transient, points=points,
-                   portrait_periods=portrait_periods, samples_per_period=samples_per_period,
-                   x0=x0, v0=v0, rtol=rtol, atol=atol, distance_tol=distance_tol,
-                   transition=transition, workers=workers)
+    with _progress("eta study") as prog:
+        ds = eta_study(params, etas, transient=transient, record=record,
+                       orbit_periods=orbit_periods, samples_per_period=samples_per_period,
+                       x0=x0, v0=v0, rtol=rtol, atol=atol, distance_tol=distance_tol,
+                       transition=transition, workers=workers, progress=prog)
     from ..plot.eta_study import plot_eta_study
     save_outputs(ds, preset, out, plot, plot_eta_study)
-    a = ds.attrs
-    typer.echo(f"{preset}: exact model period {a['exact_period'] or 'none'}, "
-               f"{'reaches' if a['exact_reaches_gamma_plus'] else 'never reaches'} Gamma+")
+    typer.echo(f"{preset}: exact model period {int(ds.exact_period) or 'none'}, "
+               f"{'reaches' if int(ds.exact_reaches_gamma_plus) else 'never reaches'} Gamma+")
     typer.echo(f"{'eta':>10s} {'Gamma+':>7s} {'period':>7s} {'distance':>10s}  agrees")
     for i, e in enumerate(ds["eta"].values):
         typer.echo(f"{e:10.3g} {int(ds.reaches_gamma_plus[i]):7d} {int(ds.period[i]):7d} "
                    f"{float(ds.distance_to_exact[i]):10.3g}  {'yes' if ds.agrees[i] else 'no'}")
-    rec = a["recommended_eta"]
+    rec = float(ds.recommended_eta)
     typer.echo(f"recommended eta: {rec:.3g}" if math.isfinite(rec) else
                "recommended eta: none of the values agrees with the exact model")
     echo_written(out, plot)

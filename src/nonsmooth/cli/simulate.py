@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from typing import Annotated
+from typing import Annotated, Optional
 
 import typer
 
@@ -18,7 +18,9 @@ def simulate_cmd(
     set_: SetOpt = None,
     periods: Annotated[int, typer.Option(help="recorded forcing periods")] = 10,
     transient: Annotated[int, typer.Option(help="forcing periods discarded first")] = 0,
-    samples_per_period: Annotated[int, typer.Option(help="samples per forcing period")] = 200,
+    samples_per_period: Annotated[Optional[int], typer.Option(
+        help="samples per forcing period  [default: that of nonsmooth.simulate, 200]",
+        show_default=False)] = None,
     x0: Annotated[float, typer.Option(help="initial X")] = 0.0,
     v0: Annotated[float, typer.Option(help="initial V")] = 0.0,
     method: MethodOpt = "smooth",
@@ -34,13 +36,16 @@ def simulate_cmd(
     params = load_params(preset, set_)
     require_output(out, plot)
     check_outputs(out, plot)
-    ds = simulate(params, periods=periods, transient=transient, samples_per_period=samples_per_period,
-                  x0=x0, v0=v0, method=method, rtol=rtol, atol=atol, transition=transition)
+    from ..simulate import mask_names
+    from .analyses import _progress
+    spp = {} if samples_per_period is None else {"samples_per_period": samples_per_period}
+    with _progress("simulate") as prog:
+        ds = simulate(params, periods=periods, transient=transient, x0=x0, v0=v0, method=method,
+                      rtol=rtol, atol=atol, transition=transition, progress=prog, **spp)
     from ..plot.time_response import plot_time_response
     save_outputs(ds, preset, out, plot, plot_time_response)
-    visited = sorted(set(int(r) for r in ds.region.values))
-    typer.echo(f"{preset}: {periods} periods after {transient}, max X = {float(ds.X.max()):.6g}, "
-               f"regions visited {visited}")
+    typer.echo(f"{preset}: {periods} periods after {transient}, max X = {float(ds.max_X):.6g}, "
+               f"min X = {float(ds.min_X):.6g}, regions visited: {', '.join(mask_names(ds.regions_visited))}")
     echo_written(out, plot)
 
 

@@ -58,8 +58,11 @@ Corner cases (all end with a status, never a hang)
   (also seen at such a degenerate corner: the derivative bounds then allow only pieces of
   about the time tolerance).
 * ``status.NON_FINITE``: non-finite input state or parameters giving non-finite values.
-* ``status.EVENT_FAILED``: an undamped mode forced exactly at its resonance (no bounded
-  closed form), or a certified root that the refinement could not converge (not observed).
+* ``status.RESONANCE``: an undamped mode forced exactly at its resonance (xi = 0 and
+  omega = omega0 in free flight; xi + xi_s = 0 and omega^2 = omega0^2 + omega_s^2 in contact):
+  the secular solution is not handled, ``method="smooth"`` is.
+* ``status.EVENT_FAILED``: a certified root that the refinement could not converge (not
+  observed).
 
 ``opts[OPT_RTOL]``, ``opts[OPT_ATOL]`` and ``opts[OPT_TRANSITION]`` are ignored: the solution
 is exact to round-off and event times are located to ``tol_t`` = 2e-14 max(1, T).
@@ -157,10 +160,10 @@ def advance_exact(p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
         return st.NON_FINITE
     MC = np.empty((2, N_MC))
     if not mode_coeffs(w0 * w0, xi, 0.0, F0, om, THETA, MC[0]):
-        return st.EVENT_FAILED
+        return st.RESONANCE
     if not mode_coeffs(w0 * w0 + ws * ws, xi + xis, ws * ws, F0, om, THETA, MC[1]):
         if support:
-            return st.EVENT_FAILED
+            return st.RESONANCE
         MC[1, :] = MC[0, :]
     FN = np.zeros((3, 3))
     FN[_F_HA, 0] = 1.0

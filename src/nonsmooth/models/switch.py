@@ -47,10 +47,8 @@ SIGMA_ALPHA = 1
 SIGMA_BETA = 2
 GAMMA_PLUS = 3
 
-REGION_NAMES = ("Gamma-", "Sigma_alpha", "Sigma_beta", "Gamma+")
 #: One word per region code, for CF ``flag_meanings`` and labels.
 REGION_NAMES = ("Gamma_minus", "Sigma_alpha", "Sigma_beta", "Gamma_plus")
-REGION_LEGEND = "0: Gamma- (free flight), 1: Sigma_alpha, 2: Sigma_beta, 3: Gamma+ (contact)"
 
 TRANSITION_EQ13 = 0
 TRANSITION_EQ12 = 1

@@ -5,13 +5,12 @@ Both figures read a Dataset from :func:`nonsmooth.analysis.basins.basins`; they 
 
 from __future__ import annotations
 
-import matplotlib.pyplot as plt
 import numpy as np
 from matplotlib.colors import BoundaryNorm, ListedColormap
 from matplotlib.lines import Line2D
 from matplotlib.patches import Patch
 
-from .common import param_title
+from .common import new_figure, param_title
 
 #: Basin colours: light for attractors without contact, dark for those with contact (as in the
 #: paper's Fig. 7), cycling through hues when there are several of a kind.
@@ -34,10 +33,14 @@ def attractor_colors(ds) -> list[str]:
     return out
 
 
+def _chaotic(ds, k) -> bool:
+    return "kind" in ds and int(ds["kind"].values[k]) == 1
+
+
 def _describe(ds, k) -> str:
-    per = int(ds["period"].values[k])
+    what = "chaotic" if _chaotic(ds, k) else f"period {int(ds['period'].values[k])}"
     contact = "contact" if int(ds["contact"].values[k]) else "no contact"
-    return f"A{k}: period {per}, {contact}, {100 * float(ds['fraction'].values[k]):.1f}%"
+    return f"A{k}: {what}, {contact}, {100 * float(ds['fraction'].values[k]):.1f}%"
 
 
 def _section_points(ds, k):
@@ -51,7 +54,7 @@ def plot_basins(ds, ax=None, points: bool = True):
     """Basin image over (x0, v0): one discrete colour per attractor, undecided points in grey,
     a legend with period, contact and basin fraction, the attractors' section points overlaid."""
     if ax is None:
-        fig, ax = plt.subplots(figsize=(6.4, 5.6))
+        fig, ax = new_figure(figsize=(6.4, 5.6))
     else:
         fig = ax.figure
     n_att = ds.sizes.get("attractor", 0)
@@ -66,7 +69,7 @@ def plot_basins(ds, ax=None, points: bool = True):
               aspect="auto", interpolation="nearest")
     handles = [Patch(facecolor=colors[k], edgecolor="k", lw=0.5, label=_describe(ds, k))
                for k in range(n_att)]
-    und = float(ds.attrs.get("undecided_fraction", 0.0))
+    und = float(np.mean(np.asarray(ds["label"].values) < 0))
     if und > 0 or n_att == 0:
         handles.append(Patch(facecolor=UNDECIDED_COLOR, edgecolor="k", lw=0.5,
                              label=f"undecided: {100 * und:.1f}%"))
@@ -74,8 +77,9 @@ def plot_basins(ds, ax=None, points: bool = True):
         for k in range(n_att):
             X, V = _section_points(ds, k)
             m = _MARKERS[k % len(_MARKERS)]
-            ax.scatter(X, V, s=70, marker=m, facecolor=colors[k], edgecolor="k", lw=1.3, zorder=3)
-            ax.scatter(X, V, s=70, marker=m, facecolor="none", edgecolor="w", lw=0.5, zorder=4)
+            size = 12 if _chaotic(ds, k) else 70
+            ax.scatter(X, V, s=size, marker=m, facecolor=colors[k], edgecolor="k", lw=1.3, zorder=3)
+            ax.scatter(X, V, s=size, marker=m, facecolor="none", edgecolor="w", lw=0.5, zorder=4)
         if n_att:
             handles.append(Line2D([], [], ls="none", marker="o", mfc="w", mec="k",
                                   label="section points (t = kT)"))
@@ -93,10 +97,11 @@ def plot_basins(ds, ax=None, points: bool = True):
 
 
 def plot_attractors(ds, ax=None):
-    """The coexisting periodic orbits in the phase plane (like Fig. 8): each attractor's orbit
-    over its whole period, its section points, and the support position X = 1."""
+    """The coexisting attractors in the phase plane (like Fig. 8): each periodic attractor's
+    orbit over its whole period (a chaotic one: over a few forcing periods, thinner), its
+    section points, and the support position X = 1."""
     if ax is None:
-        fig, ax = plt.subplots(figsize=(6.4, 5.2))
+        fig, ax = new_figure(figsize=(6.4, 5.2))
     else:
         fig = ax.figure
     n_att = ds.sizes.get("attractor", 0)
@@ -105,18 +110,20 @@ def plot_attractors(ds, ax=None):
         X = np.asarray(ds["orbit_X"].values[k], dtype=float)
         V = np.asarray(ds["orbit_V"].values[k], dtype=float)
         keep = np.isfinite(X) & np.isfinite(V)
-        ax.plot(X[keep], V[keep], color=colors[k], lw=2.0, label=_describe(ds, k), zorder=2)
+        ax.plot(X[keep], V[keep], color=colors[k], lw=0.6 if _chaotic(ds, k) else 2.0,
+                label=_describe(ds, k), zorder=2)
         if not int(ds["contact"].values[k]):  # light colours need an outline on white
             ax.plot(X[keep], V[keep], color="0.35", lw=0.5, zorder=2)
         Xs, Vs = _section_points(ds, k)
-        ax.scatter(Xs, Vs, s=55, marker=_MARKERS[k % len(_MARKERS)], facecolor=colors[k],
+        ax.scatter(Xs, Vs, s=12 if _chaotic(ds, k) else 55, marker=_MARKERS[k % len(_MARKERS)],
+                   facecolor=colors[k],
                    edgecolor="k", lw=1.0, zorder=3)
     ax.axvline(1.0, color="k", lw=0.8, ls="--", label="support (X = 1)")
     ax.set_xlabel("X = x/g")
     ax.set_ylabel(r"V = $\dot X$")
     ax.legend(loc="best", fontsize=8)
     omega = ds.attrs.get("param_omega")
-    title = "coexisting periodic attractors"
+    title = "coexisting attractors"
     if omega is not None:
         title += rf", $\omega$ = {float(omega):.4g} rad/s"
     ax.set_title(f"{title}\n{ds.attrs.get('method', '')}: {param_title(ds)}", fontsize=9)

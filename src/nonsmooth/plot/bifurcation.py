@@ -2,10 +2,9 @@
 
 from __future__ import annotations
 
-import matplotlib.pyplot as plt
 import numpy as np
 
-from .common import param_title
+from .common import new_figure, param_title
 
 SWEEP_STYLE = {
     "up": dict(color="#1f77b4", marker=".", label="sweep up"),
@@ -17,16 +16,25 @@ SYMBOLS = {"omega": r"$\omega$", "F0": r"$F_0$", "omega_s": r"$\omega_s$", "xi":
            "xi_s": r"$\xi_s$", "omega0": r"$\omega_0$", "eta": r"$\eta$"}
 
 
+def sweep_names(ds) -> list[str]:
+    """The direction names ("up", "down", "fresh") of the integer ``sweep`` coordinate of a
+    bifurcation or resonance Dataset, from its CF flag_values / flag_meanings."""
+    sw = ds["sweep"]
+    meanings = dict(zip(np.asarray(sw.attrs["flag_values"]).tolist(),
+                        sw.attrs["flag_meanings"].split()))
+    return [meanings[int(c)] for c in np.atleast_1d(sw.values)]
+
+
 def plot_bifurcation(ds, var: str = "X"):
     """Section ``var`` (X or V) of every recorded period versus the swept parameter; up and
     down sweeps in different colours and markers, small dots; failed points are left out."""
-    param = ds.attrs.get("swept_param") or ds.attrs["param"]
-    fig, ax = plt.subplots(figsize=(10, 5.5))
+    param = ds.attrs["swept_param"]
+    fig, ax = new_figure(figsize=(10, 5.5))
     vals = ds[param].values
     nsw = ds.sizes["sweep"]
     npts = vals.size * ds.sizes["n"]
     size = 0.6 if npts > 20000 else 2.0
-    for j, name in enumerate(ds.sweep.values):
+    for j, name in enumerate(sweep_names(ds)):
         y = ds[var].values[j]  # (value, n)
         x = np.broadcast_to(vals[:, None], y.shape)
         ok = np.isfinite(y)

@@ -7,6 +7,15 @@ import numpy as np
 from . import REGION_COLORS, REGION_LABELS
 
 
+def new_figure(nrows: int = 1, ncols: int = 1, *, figsize=None, **subplots_kw):
+    """``(fig, axes)`` like ``plt.subplots`` but without pyplot: a ``matplotlib.figure.Figure``
+    that no backend or pyplot state knows about (saved by ``nonsmooth.io.save_figure``, shown
+    in a notebook by displaying ``fig``). ``subplots_kw`` go to ``Figure.subplots``."""
+    from matplotlib.figure import Figure
+    fig = Figure(figsize=figsize)
+    return fig, fig.subplots(nrows, ncols, **subplots_kw)
+
+
 def scatter_by_region(ax, x, y, region, s=2.0, legend=True, **kw):
     """Scatter (x, y) coloured by region code; only the regions present get a legend entry."""
     region = np.asarray(region)

@@ -6,8 +6,7 @@ import math
 
 import numpy as np
 
-from . import REGION_LABELS  # noqa: F401  (sets the Agg backend)
-from .common import draw_band_edges, param_title, scatter_by_region
+from .common import draw_band_edges, new_figure, param_title, scatter_by_region
 
 
 def _verdict(ds, i) -> str:
@@ -15,8 +14,8 @@ def _verdict(ds, i) -> str:
         return "failed"
     reach = int(ds["reaches_gamma_plus"].values[i])
     per = int(ds["period"].values[i])
-    e_reach = int(ds.attrs.get("exact_reaches_gamma_plus", -1))
-    e_per = int(ds.attrs.get("exact_period", -1))
+    e_reach = int(ds["exact_reaches_gamma_plus"])
+    e_per = int(ds["exact_period"])
     if int(ds["agrees"].values[i]):
         return "agrees with exact"
     if reach != e_reach:
@@ -30,22 +29,21 @@ def plot_eta_study(ds):
     """Phase portraits (X, V) per eta, points coloured by region, band edges X = 1 +- eta and
     h_beta = +-eta, the exact (eta = 0) orbit overlaid, and an enlargement of the band around
     X = 1. Title: eta and the verdict of the audit. Dataset in, Figure out."""
-    import matplotlib.pyplot as plt
-
+    
     etas = np.asarray(ds["eta"].values, dtype=float)
     n = len(etas)
     ncol = min(n, 2) if n <= 4 else 3
     nrow = int(math.ceil(n / ncol))
-    fig, axes = plt.subplots(nrow, ncol, figsize=(5.2 * ncol, 4.2 * nrow), squeeze=False)
+    fig, axes = new_figure(nrow, ncol, figsize=(5.2 * ncol, 4.2 * nrow), squeeze=False)
     ws = float(ds.attrs.get("param_omega_s", 0.0))
     xis = float(ds.attrs.get("param_xi_s", 0.0))
-    eX = np.asarray(ds["exact_portrait_X"].values)
-    eV = np.asarray(ds["exact_portrait_V"].values)
+    eX = np.asarray(ds["exact_orbit_X"].values)
+    eV = np.asarray(ds["exact_orbit_V"].values)
     for i, eta in enumerate(etas):
         ax = axes[i // ncol][i % ncol]
-        X = np.asarray(ds["portrait_X"].values[i])
-        V = np.asarray(ds["portrait_V"].values[i])
-        R = np.asarray(ds["portrait_region"].values[i])
+        X = np.asarray(ds["orbit_X"].values[i])
+        V = np.asarray(ds["orbit_V"].values[i])
+        R = np.asarray(ds["orbit_region"].values[i])
         ok = np.isfinite(X) & np.isfinite(V)
         scatter_by_region(ax, X[ok], V[ok], R[ok], s=2.0, legend=(i == 0))
         ax.plot(eX, eV, color="k", lw=0.5, alpha=0.7, label="exact ($\\eta = 0$)" if i == 0 else None)
@@ -77,8 +75,8 @@ def plot_eta_study(ds):
     if handles:
         fig.legend(handles, labels, loc="lower center", ncol=min(len(labels), 6), fontsize=8,
                    markerscale=4, frameon=False)
-    rec = ds.attrs.get("recommended_eta", float("nan"))
-    rec_s = f"{rec:.3g}" if isinstance(rec, (int, float)) and math.isfinite(rec) else "none"
+    rec = float(ds["recommended_eta"])
+    rec_s = f"{rec:.3g}" if math.isfinite(rec) else "none"
     fig.suptitle(f"Band half-width audit ({param_title(ds, keys=('omega0', 'omega_s', 'xi', 'xi_s', 'F0', 'omega'))});"
                  f" recommended $\\eta$ = {rec_s}", fontsize=10)
     fig.tight_layout(rect=(0, 0.05, 1, 0.96))

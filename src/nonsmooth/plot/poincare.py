@@ -2,27 +2,28 @@
 
 from __future__ import annotations
 
-import matplotlib.pyplot as plt
 
-from .common import param_title, scatter_by_region
+from .common import new_figure, param_title, scatter_by_region
 
 
 def _period_text(ds) -> str:
-    p = int(ds.attrs.get("period", 0))
-    kind = f"period-{p}" if p > 0 else "not periodic (chaotic or quasi-periodic)"
-    contact = "contact" if int(ds.attrs.get("contact", 0)) else "no contact"
+    p = int(ds["period"])
+    kind = (f"period-{p}" if p > 0 else "not periodic (chaotic or quasi-periodic)" if p == 0
+            else "not settled (still converging)")
+    contact = "contact" if int(ds["contact"]) else "no contact"
     return f"{kind}, {contact}"
 
 
 def plot_poincare(ds):
     """Left: phase portrait V(X) over the orbit run (coloured by region) with the section
     points on it; right: the Poincaré map (all section points, small dots)."""
-    fig, (ax0, ax1) = plt.subplots(1, 2, figsize=(11, 4.6))
+    fig, (ax0, ax1) = new_figure(1, 2, figsize=(11, 4.6))
     oX, oV, oR = ds.orbit_X.values, ds.orbit_V.values, ds.orbit_region.values
     X, V = ds.X.values, ds.V.values
     ax0.plot(oX, oV, color="0.55", lw=0.6, zorder=1)
     scatter_by_region(ax0, oX, oV, oR, s=1.5, zorder=2)
-    ax0.scatter(X, V, s=16 if X.size <= 64 or ds.attrs.get("period", 0) else 1.0, color="k",
+    few = X.size <= 64 or int(ds["period"]) > 0
+    ax0.scatter(X, V, s=16 if few else 1.0, color="k",
                 marker="o", zorder=3, linewidths=0,
                 label=r"section $t = kT$")
     ax0.axvline(1.0, color="k", lw=0.6, ls="--")
@@ -31,7 +32,6 @@ def plot_poincare(ds):
     ax0.set_title(f"(a) phase portrait: {_period_text(ds)}", fontsize=10)
     ax0.legend(loc="lower left", fontsize=7, markerscale=2)
     n = X.size
-    few = n <= 64 or int(ds.attrs.get("period", 0)) > 0
     ax1.scatter(X, V, s=25.0 if few else (1.0 if n > 500 else 6.0), color="k", linewidths=0)
     ax1.set_xlabel(r"$X(kT)$")
     ax1.set_ylabel(r"$V(kT)$")

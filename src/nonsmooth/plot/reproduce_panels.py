@@ -2,11 +2,11 @@
 
 from __future__ import annotations
 
-import matplotlib.pyplot as plt
 import numpy as np
 
+from ..reproduction.access import value, x_extrema
 from . import REGION_COLORS
-from .common import draw_band_edges, param_title, scatter_by_region
+from .common import draw_band_edges, new_figure, param_title, scatter_by_region
 
 
 def plot_support_stiffness(ds):
@@ -14,7 +14,7 @@ def plot_support_stiffness(ds):
     and the phase portrait (bottom), coloured by region, the support position X = 1 drawn."""
     ws = ds["omega_s"].values
     n = ws.size
-    fig, axes = plt.subplots(2, n, figsize=(3.2 * n, 6.2), squeeze=False)
+    fig, axes = new_figure(2, n, figsize=(3.2 * n, 6.2), squeeze=False)
     for j, w in enumerate(ws):
         d = ds.isel(omega_s=j)
         t, X, V, R = d.t.values, d.X.values, d.V.values, d.region.values
@@ -22,7 +22,7 @@ def plot_support_stiffness(ds):
         ax.plot(t - t[0], X, color="0.75", lw=0.7, zorder=0)
         scatter_by_region(ax, t - t[0], X, R, s=2, legend=(j == 0))
         ax.axhline(1.0, color="k", lw=0.6, ls="--")
-        ax.set_title(rf"$\omega_s$ = {w:g}, max X = {np.nanmax(X):.4f}", fontsize=9)
+        ax.set_title(rf"$\omega_s$ = {w:g}, max X = {x_extrema(d)[0]:.4f}", fontsize=9)
         ax.set_xlabel("t - t0 [s]")
         if j == 0:
             ax.set_ylabel("X")
@@ -43,7 +43,7 @@ def plot_support_stiffness(ds):
 def plot_coexisting(ds):
     """Fig. 8: the coexisting periodic orbits (dimension ``attractor``) in the phase plane, each
     with its section points; the support position X = 1 drawn."""
-    fig, ax = plt.subplots(figsize=(6.5, 5))
+    fig, ax = new_figure(figsize=(6.5, 5))
     colors = ("0.15", "#e08214", "#2166ac", "#1b7837")
     for k, a in enumerate(ds["attractor"].values):
         d = ds.sel(attractor=a)
@@ -65,21 +65,23 @@ def plot_coexisting(ds):
 
 
 def _per(p) -> str:
-    return f"period {int(p)}" if int(p) > 0 else "not periodic"
+    p = int(p)
+    return f"period {p}" if p > 0 else ("not settled" if p < 0 else "not periodic")
 
 
 def plot_section_panel(ds, title: str = "", exact=None):
     """Figs. 10/12: phase portrait coloured by region with the Poincaré section points (left)
     and the Poincaré map alone (right). ``ds`` is a ``poincare`` Dataset; ``exact`` an optional
     one of the exact model at the same parameters, drawn in grey for comparison."""
-    fig, axes = plt.subplots(1, 2, figsize=(12, 4.8))
+    fig, axes = new_figure(1, 2, figsize=(12, 4.8))
     a = ds.attrs
+    per = int(value(ds, "period", 0))
     ax = axes[0]
     ox, ov, orr = ds.orbit_X.values, ds.orbit_V.values, ds.orbit_region.values
     ax.plot(ox, ov, color="0.7", lw=0.6, zorder=0)
     scatter_by_region(ax, ox, ov, orr, s=1.5)
     npts = min(ds.sizes["n"], 2000)
-    ax.plot(ds.X.values[-npts:], ds.V.values[-npts:], "k.", ms=4 if a.get("period", 0) else 1,
+    ax.plot(ds.X.values[-npts:], ds.V.values[-npts:], "k.", ms=4 if per > 0 else 1,
             label="section t = kT", zorder=3)
     draw_band_edges(ax, float(a["param_eta"]), float(a["param_omega_s"]), float(a["param_xi_s"]),
                     label=False)
@@ -91,15 +93,14 @@ def plot_section_panel(ds, title: str = "", exact=None):
     ax = axes[1]
     if exact is not None:
         ax.plot(exact.X.values, exact.V.values, ".", color="0.6", ms=2,
-                label=f"exact model ({_per(exact.attrs.get('period', 0))})")
-    ax.plot(ds.X.values, ds.V.values, ".", color=REGION_COLORS[3], ms=6 if a.get("period", 0) else 2,
-            label=f"smoothed switch model ({_per(a.get('period', 0))})")
+                label=f"exact model ({_per(value(exact, 'period', 0))})")
+    ax.plot(ds.X.values, ds.V.values, ".", color=REGION_COLORS[3], ms=6 if per > 0 else 2,
+            label=f"smoothed switch model ({_per(per)})")
     ax.set_xlabel("X")
     ax.set_ylabel("V = dX/dt")
     ax.set_title(f"Poincaré section ({ds.sizes['n']} points)", fontsize=9)
     ax.legend(fontsize=7, markerscale=3)
-    per = int(a.get("period", 0))
-    fig.suptitle(f"{title} -- {'period ' + str(per) if per else 'not periodic'}, "
-                 f"max X = {float(a.get('max_X', np.nan)):.4f}\n{param_title(ds)}", fontsize=9)
+    fig.suptitle(f"{title} -- {_per(per)}, max X = {float(value(ds, 'max_X')):.4f}\n"
+                 f"{param_title(ds)}", fontsize=9)
     fig.tight_layout()
     return fig

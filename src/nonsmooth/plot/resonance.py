@@ -4,18 +4,17 @@ from __future__ import annotations
 
 import math
 
-import matplotlib.pyplot as plt
 
-from .bifurcation import SWEEP_STYLE, _others
-from .common import param_title
+from .bifurcation import SWEEP_STYLE, _others, sweep_names
+from .common import new_figure, param_title
 
 
 def plot_resonance(ds, show_min: bool = True):
     """max X (and min X) of the settled response versus omega for the up and the down sweep,
     with vertical lines at omega_a (contact starts), omega_b and omega_c (jumps)."""
-    fig, ax = plt.subplots(figsize=(8, 5))
+    fig, ax = new_figure(figsize=(8, 5))
     w = ds.omega.values
-    for j, name in enumerate(ds.sweep.values):
+    for j, name in enumerate(sweep_names(ds)):
         style = dict(SWEEP_STYLE.get(str(name), dict(color="0.3", marker=".", label=str(name))))
         ls = "-" if str(name) == "up" else "--"
         ax.plot(w, ds.max_X.values[j], ls=ls, lw=1.0, markersize=3, **style)

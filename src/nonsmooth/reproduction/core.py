@@ -10,6 +10,7 @@ the measured numbers, never written in by hand.
 from __future__ import annotations
 
 import math
+import re
 import time
 import traceback
 from dataclasses import dataclass, field
@@ -36,6 +37,11 @@ class Check:
             raise ValueError(f"verdict: must be one of {VERDICTS}, got {self.verdict!r}")
 
 
+#: FigureRecord fields stored in ``summary.json`` (paths as names inside the output folder)
+_STORED = ("id", "title", "params", "method", "settings", "notes", "seconds", "error",
+           "traceback", "gaps", "run")
+
+
 @dataclass
 class FigureRecord:
     """Everything the report says about one figure."""
@@ -51,6 +57,10 @@ class FigureRecord:
     seconds: float = 0.0
     error: str = ""
     traceback: str = ""
+    #: evidence for the report's section on the paper's gaps: [topic, text] pairs
+    gaps: list = field(default_factory=list)
+    #: the run that computed this figure (command, mode, date, ...), see ``reproduce``
+    run: dict = field(default_factory=dict)
 
     # -- recording helpers -------------------------------------------------------------
     def check(self, claim: str, measured: str, verdict: str, evidence: str = "") -> Check:
@@ -76,6 +86,20 @@ class FigureRecord:
             out[c.verdict] += 1
         return out
 
+    # -- summary.json ------------------------------------------------------------------
+    def to_dict(self) -> dict:
+        d = {k: getattr(self, k) for k in _STORED}
+        d["checks"] = [c.__dict__ for c in self.checks]
+        d["files"] = [Path(f).name for f in self.files]
+        return d
+
+    @classmethod
+    def from_dict(cls, d: dict, out: Path) -> "FigureRecord":
+        rec = cls(**{k: d[k] for k in _STORED})
+        rec.checks = [Check(**c) for c in d["checks"]]
+        rec.files = [Path(out) / f for f in d["files"]]
+        return rec
+
 
 @dataclass(frozen=True)
 class FigureSpec:
@@ -90,11 +114,20 @@ class FigureSpec:
 FIGURES: dict[str, FigureSpec] = {}
 
 
+def paper_order(fid: str):
+    """Sort key of a figure id: "fig10a" -> (10, "a"); other ids after the paper's."""
+    m = re.fullmatch(r"fig(\d+)([a-z]*)", fid)
+    return (int(m[1]), m[2]) if m else (math.inf, fid)
+
+
 def figure(id: str, title: str, claim: str, cost: float = 1.0):
-    """Decorator registering ``entry(ctx, rec)`` as the reproduction of figure ``id``."""
+    """Decorator registering ``entry(ctx, rec)`` as the reproduction of figure ``id`` (the
+    registry stays in paper order whatever the order of registration)."""
 
     def deco(fn):
         FIGURES[id] = FigureSpec(id, title, claim, fn, cost)
+        for k in sorted(FIGURES, key=paper_order):
+            FIGURES[k] = FIGURES.pop(k)
         return fn
 
     return deco
@@ -113,9 +146,10 @@ class Context:
         self.cache: dict = {}
         self.current: FigureRecord | None = None
 
-    def pick(self, full, quick):
-        """``quick`` value in --quick mode, else ``full``."""
-        return quick if self.quick else full
+    def setting(self, group: str, name: str):
+        """Setting ``name`` of ``group`` in this run's mode (``settings.SETTINGS``)."""
+        from .settings import SETTINGS
+        return SETTINGS[group][name][self.quick]
 
     def shared(self, key: str, compute: Callable):
         """Compute once per run; later figures get the same object (errors are re-raised)."""
@@ -136,11 +170,7 @@ class Context:
 
     def save(self, ds, name: str) -> Path:
         from ..io import save_dataset
-        p = self.out / f"{name}.nc"
-        if p.exists():
-            p.unlink()
-        save_dataset(ds, p)
-        return self._record(p)
+        return self._record(save_dataset(ds, self.out / f"{name}.nc"))
 
     def savefig(self, fig, name: str) -> Path:
         from ..io import save_figure
@@ -149,8 +179,12 @@ class Context:
         return self._record(p)
 
 
-def run_figures(ids, ctx: Context) -> list[FigureRecord]:
-    """Run the figures ``ids`` in order; a failing figure gets its error recorded, the run goes on."""
+def run_figures(ids, ctx: Context, done: Callable[[FigureRecord], None] = lambda rec: None
+                ) -> list[FigureRecord]:
+    """Run the figures ``ids`` in order and hand each record to ``done`` as soon as the figure
+    is finished (the report is rewritten there, so an interrupted run keeps what is done). A
+    failing figure gets its error recorded and the run goes on; on Ctrl-C the figure in
+    progress is recorded as interrupted, handed to ``done``, and the interrupt goes on."""
     records = []
     for fid in ids:
         spec = FIGURES[fid]
@@ -160,6 +194,11 @@ def run_figures(ids, ctx: Context) -> list[FigureRecord]:
         t0 = time.perf_counter()
         try:
             spec.entry(ctx, rec)
+        except KeyboardInterrupt:
+            rec.seconds = time.perf_counter() - t0
+            rec.error = "interrupted before the figure was finished (its files may be partial)"
+            done(rec)
+            raise
         except Exception as exc:  # noqa: BLE001 - one figure never stops the run
             rec.error = f"{type(exc).__name__}: {exc}".strip()
             rec.traceback = traceback.format_exc(limit=6)
@@ -175,6 +214,7 @@ def run_figures(ids, ctx: Context) -> list[FigureRecord]:
             f"{c[AGREES]} agree, {c[DIFFERS]} differ, {c[NOT_STATED]} not stated")
         ctx.log(f"{fid}: {rec.seconds:.1f} s, {status}")
         records.append(rec)
+        done(rec)
     return records
 
 
@@ -188,12 +228,15 @@ def agree_if(condition) -> str:
 
 
 def period_text(p) -> str:
-    """'period 3', 'not periodic (chaotic/quasi-periodic)', or 'unknown'."""
+    """'period 3', 'not periodic (...)', 'not settled (...)' (a negative code: the analyses'
+    label of a section that has not settled yet) or 'unknown'."""
     if p is None or (isinstance(p, float) and math.isnan(p)):
         return "unknown"
     p = int(p)
     if p == 0:
         return "not periodic (period 0: chaotic or quasi-periodic)"
+    if p < 0:
+        return "not settled (no period can be told yet; a longer transient is needed)"
     return f"period {p}"
 
 

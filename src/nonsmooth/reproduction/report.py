@@ -5,18 +5,24 @@ from __future__ import annotations
 
 import base64
 import html
+import json
 import platform
+import re
 from pathlib import Path
 
 from .core import AGREES, DIFFERS, FIGURES, NOT_STATED, FigureRecord
+from .settings import rows as settings_rows
 
 VERDICT_MARK = {AGREES: "agrees", DIFFERS: "DIFFERS", NOT_STATED: "not stated"}
 VERDICT_COLOR = {AGREES: "#1a7f37", DIFFERS: "#cf222e", NOT_STATED: "#6e7781"}
+#: version of the layout of ``summary.json`` (a folder with another layout starts afresh)
+SUMMARY_FORMAT = 2
 
 
-def gaps(evidence: dict, quick: bool) -> list[tuple[str, str, list[str]]]:
-    """(title, what the paper says / what we chose, evidence lines computed in this run)."""
-    from .figures import BASIN_WINDOW, IC, JUST_AFTER
+def gaps(evidence: dict, quick_ids: list[str]) -> list[tuple[str, str, list[str]]]:
+    """(title, what the paper says / what we chose, evidence lines computed by the figures);
+    ``quick_ids``: the figures computed in --quick mode."""
+    from .figures._common import BASIN_WINDOW, IC, JUST_AFTER
     ev = lambda key: list(evidence.get(key, []))  # noqa: E731
     return [
         ("Eqs. 13a/13b are not the convex combinations of eqs. 12a/12b",
@@ -44,8 +50,8 @@ def gaps(evidence: dict, quick: bool) -> list[tuple[str, str, list[str]]]:
          "the previous one (the first from (0, 0)); basins use initial conditions at phase 0 on "
          f"X0 in {BASIN_WINDOW[0]}, V0 in {BASIN_WINDOW[1]}; chaos 'just after' grazing means "
          f"within {JUST_AFTER:.0%} of the swept range. Transients and grid sizes are listed "
-         "per figure" + (" (this is a --quick run: coarser grids, shorter transients)." if quick
-                         else "."), []),
+         "per figure" + (f" ({', '.join(quick_ids)} from a --quick run: coarser grids, shorter "
+                         "transients)." if quick_ids else "."), []),
         ("Fig. 7 colours and direction of the basin change",
          "The text calls the light basin 'without contact', then the non-impact attractor "
          "'dark' and the impact basin 'light'. We classify attractors by contact (max X >= 1 and "
@@ -74,24 +80,70 @@ def _summary_rows(records):
         yield r, c, status
 
 
-def write_markdown(records: list[FigureRecord], meta: dict, evidence: dict, out: Path) -> Path:
+def runs_of(records) -> list[tuple[dict, list[str]]]:
+    """The runs that computed the figures shown, oldest first, each with its figure ids."""
+    runs: dict = {}
+    for r in records:
+        key = (r.run["date"], r.run["command"])
+        runs.setdefault(key, (r.run, []))[1].append(r.id)
+    return [runs[k] for k in sorted(runs)]
+
+
+def _mode(run: dict) -> str:
+    return "quick" if run["quick"] else "full"
+
+
+def header_lines(records) -> list[str]:
+    """Which run computed which figures (command, settings, date): plain-text lines."""
+    runs = runs_of(records)
+    modes = sorted({_mode(run) for run, _ in runs})
+    if len(modes) == 1:
+        mode = modes[0] + (" (coarser grids, shorter transients)" if modes == ["quick"] else "")
+    else:
+        mode = "mixed: " + "; ".join(
+            f"{m}: {', '.join(i for run, ids in runs for i in ids if _mode(run) == m)}"
+            for m in modes)
+    lines = [f"Mode: {mode}."]
+    if len(runs) > 1:
+        lines.append(f"{len(runs)} runs into this folder computed the figures below (a later "
+                     "run replaces the figures it re-ran):")
+    for run, ids in runs:
+        lines.append(f"Run {run['date']}: `{run['command']}` ({_mode(run)}; "
+                     f"{run['seconds']:.1f} s; {run['workers']} worker thread(s); nonsmooth "
+                     f"{run['version']}; {run['platform']}): {', '.join(ids)}")
+    return lines
+
+
+def evidence_of(records) -> dict:
+    """Gap evidence of all figures shown, by topic, in paper order."""
+    ev: dict = {}
+    for r in records:
+        for key, text in r.gaps:
+            ev.setdefault(key, []).append(text)
+    return ev
+
+
+def _computed_by(r) -> str:
+    return f"{_mode(r.run)} run of {r.run['date']}"
+
+
+def markdown(records: list[FigureRecord], out: Path) -> str:
+    evidence = evidence_of(records)
+    quick_ids = [r.id for r in records if r.run["quick"]]
     L = ["# Reproduction of 'Nonlinear dynamics and chaos in systems with discontinuous support'",
-         "",
-         f"Command: `{meta['command']}`  ",
-         f"Mode: {'quick' if meta['quick'] else 'full'}; total run time {meta['seconds']:.1f} s; "
-         f"{meta['workers']} worker thread(s); nonsmooth {meta['version']}; "
-         f"{meta['platform']}  ",
-         f"Generated {meta['date']}.",
-         "",
-         "Every verdict below is computed from the data of this run: *agrees* / *differs* compare "
-         "a measured quantity with the paper's statement; *not stated* gives a measurement the "
-         "paper does not make a claim about.",
-         "", "## Summary", "",
-         "| figure | claim of the paper | agrees | differs | not stated | time [s] | status |",
-         "|---|---|---:|---:|---:|---:|---|"]
+         ""]
+    L += [f"{line}  " for line in header_lines(records)]
+    L += ["",
+          "Every verdict below is computed from the data of the run named for the figure: "
+          "*agrees* / *differs* compare a measured quantity with the paper's statement by the "
+          "criterion given in the row; *not stated* gives a measurement the paper does not make "
+          "a claim about.",
+          "", "## Summary", "",
+          "| figure | claim of the paper | agrees | differs | not stated | time [s] | run "
+          "| status |", "|---|---|---:|---:|---:|---:|---|---|"]
     for r, c, status in _summary_rows(records):
         L.append(f"| [{r.id}](#{r.id}) | {FIGURES[r.id].claim} | {c[AGREES]} | {c[DIFFERS]} | "
-                 f"{c[NOT_STATED]} | {r.seconds:.1f} | {status} |")
+                 f"{c[NOT_STATED]} | {r.seconds:.1f} | {_computed_by(r)} | {status} |")
     tot = {v: sum(r.counts()[v] for r in records) for v in (AGREES, DIFFERS, NOT_STATED)}
     nfail = sum(1 for r in records if r.error)
     L += ["", f"**Totals:** {tot[AGREES]} agree, {tot[DIFFERS]} differ, {tot[NOT_STATED]} not "
@@ -99,15 +151,16 @@ def write_markdown(records: list[FigureRecord], meta: dict, evidence: dict, out:
     for r in records:
         L += [f"## {r.id}", "", f"**{r.title}.** Paper: {FIGURES[r.id].claim}.", ""]
         if r.error:
-            L += [f"**FAILED** after {r.seconds:.1f} s: `{r.error}`", "", "```",
-                  r.traceback.strip(), "```", ""]
+            L += [f"**FAILED** after {r.seconds:.1f} s: `{r.error}`", ""]
+            if r.traceback:
+                L += ["```", r.traceback.strip(), "```", ""]
         if r.params:
             L.append("Parameters: " + ", ".join(f"{k} = {v}" for k, v in r.params.items()) + "  ")
         if r.method:
             L.append(f"Method: {r.method}  ")
         if r.settings:
             L.append("Settings: " + "; ".join(f"{k}: {v}" for k, v in r.settings.items()) + "  ")
-        L.append(f"Run time: {r.seconds:.1f} s")
+        L.append(f"Computed by the {_computed_by(r)} in {r.seconds:.1f} s")
         L.append("")
         if r.checks:
             L += ["| paper | ours | verdict |", "|---|---|---|"]
@@ -128,15 +181,16 @@ def write_markdown(records: list[FigureRecord], meta: dict, evidence: dict, out:
         if files:
             L += [f"Files: {files}", ""]
     L += ["## Where the paper is silent or inconsistent", ""]
-    for title, text, lines in gaps(evidence, meta["quick"]):
+    for title, text, lines in gaps(evidence, quick_ids):
         L += [f"### {title}", "", text, ""]
         for line in lines:
-            L.append(f"- Computed in this run: {line}")
+            L.append(f"- Computed: {line}")
         if lines:
             L.append("")
-    p = out / "report.md"
-    p.write_text("\n".join(L) + "\n", encoding="utf-8")
-    return p
+    L += ["## Settings of a full and a --quick run", "", "| figures | setting | full | quick |",
+          "|---|---|---:|---:|"]
+    L += [f"| {g} | {k} | {full} | {quick} |" for g, k, full, quick in settings_rows()]
+    return "\n".join(L) + "\n"
 
 
 def _img(path: Path) -> str:
@@ -144,8 +198,10 @@ def _img(path: Path) -> str:
     return f'<img alt="{html.escape(Path(path).name)}" src="data:image/png;base64,{data}">'
 
 
-def write_html(records: list[FigureRecord], meta: dict, evidence: dict, out: Path) -> Path:
+def html_page(records: list[FigureRecord], out: Path) -> str:
     e = html.escape
+    evidence = evidence_of(records)
+    quick_ids = [r.id for r in records if r.run["quick"]]
     H = ["<!DOCTYPE html><html><head><meta charset='utf-8'>",
          "<title>nonsmooth: reproduction report</title><style>",
          "body{font-family:system-ui,sans-serif;max-width:1200px;margin:2em auto;padding:0 1em;"
@@ -156,25 +212,26 @@ def write_html(records: list[FigureRecord], meta: dict, evidence: dict, out: Pat
          "</style></head><body>",
          "<h1>Reproduction of &lsquo;Nonlinear dynamics and chaos in systems with discontinuous "
          "support&rsquo;</h1>",
-         f"<p class='meta'>Command: <code>{e(meta['command'])}</code><br>Mode: "
-         f"{'quick' if meta['quick'] else 'full'}; total run time {meta['seconds']:.1f} s; "
-         f"{meta['workers']} worker thread(s); nonsmooth {e(meta['version'])}; "
-         f"{e(meta['platform'])}<br>Generated {e(meta['date'])}.</p>",
-         "<p>Every verdict is computed from the data of this run.</p>",
+         "<p class='meta'>" + "<br>".join(re.sub(r"`([^`]*)`", r"<code>\1</code>", e(line))
+                                          for line in header_lines(records)) + "</p>",
+         "<p>Every verdict is computed from the data of the run named for the figure, by the "
+         "criterion given in the row.</p>",
          "<h2>Summary</h2><table><tr><th>figure</th><th>claim of the paper</th><th>agrees</th>"
-         "<th>differs</th><th>not stated</th><th>time [s]</th><th>status</th></tr>"]
+         "<th>differs</th><th>not stated</th><th>time [s]</th><th>run</th><th>status</th></tr>"]
     for r, c, status in _summary_rows(records):
         col = VERDICT_COLOR[DIFFERS] if status != "agrees" else VERDICT_COLOR[AGREES]
         H.append(f"<tr><td><a href='#{r.id}'>{r.id}</a></td><td>{e(FIGURES[r.id].claim)}</td>"
                  f"<td>{c[AGREES]}</td><td>{c[DIFFERS]}</td><td>{c[NOT_STATED]}</td>"
-                 f"<td>{r.seconds:.1f}</td><td style='color:{col}'><b>{status}</b></td></tr>")
+                 f"<td>{r.seconds:.1f}</td><td>{e(_computed_by(r))}</td>"
+                 f"<td style='color:{col}'><b>{status}</b></td></tr>")
     H.append("</table>")
     for r in records:
         H.append(f"<h2 id='{r.id}'>{r.id}: {e(r.title)}</h2><p><b>Paper:</b> "
                  f"{e(FIGURES[r.id].claim)}.</p>")
         if r.error:
             H.append(f"<p style='color:{VERDICT_COLOR[DIFFERS]}'><b>FAILED</b> after "
-                     f"{r.seconds:.1f} s: <code>{e(r.error)}</code></p><pre>{e(r.traceback)}</pre>")
+                     f"{r.seconds:.1f} s: <code>{e(r.error)}</code></p>"
+                     + (f"<pre>{e(r.traceback)}</pre>" if r.traceback else ""))
         items = []
         if r.params:
             items.append("<b>Parameters:</b> " + e(", ".join(f"{k} = {v}" for k, v in r.params.items())))
@@ -182,7 +239,7 @@ def write_html(records: list[FigureRecord], meta: dict, evidence: dict, out: Pat
             items.append(f"<b>Method:</b> {e(r.method)}")
         if r.settings:
             items.append("<b>Settings:</b> " + e("; ".join(f"{k}: {v}" for k, v in r.settings.items())))
-        items.append(f"<b>Run time:</b> {r.seconds:.1f} s")
+        items.append(f"<b>Computed by the</b> {e(_computed_by(r))} in {r.seconds:.1f} s")
         H.append("<p>" + "<br>".join(items) + "</p>")
         if r.checks:
             H.append("<table><tr><th>paper</th><th>ours</th><th>verdict</th></tr>")
@@ -201,15 +258,40 @@ def write_html(records: list[FigureRecord], meta: dict, evidence: dict, out: Pat
             H.append("<p class='meta'>Files: " + ", ".join(
                 f"<code>{e(_rel(f, out))}</code>" for f in r.files) + "</p>")
     H.append("<h2>Where the paper is silent or inconsistent</h2>")
-    for title, text, lines in gaps(evidence, meta["quick"]):
+    for title, text, lines in gaps(evidence, quick_ids):
         H.append(f"<h3>{e(title)}</h3><p>{e(text)}</p>")
         if lines:
-            H.append("<ul>" + "".join(f"<li>Computed in this run: {e(x)}</li>" for x in lines)
-                     + "</ul>")
-    H.append("</body></html>")
-    p = out / "report.html"
-    p.write_text("\n".join(H) + "\n", encoding="utf-8")
-    return p
+            H.append("<ul>" + "".join(f"<li>Computed: {e(x)}</li>" for x in lines) + "</ul>")
+    H.append("<h2>Settings of a full and a --quick run</h2><table><tr><th>figures</th>"
+             "<th>setting</th><th>full</th><th>quick</th></tr>")
+    H += [f"<tr><td>{e(g)}</td><td>{e(k)}</td><td>{full}</td><td>{quick}</td></tr>"
+          for g, k, full, quick in settings_rows()]
+    H.append("</table></body></html>")
+    return "\n".join(H) + "\n"
+
+
+def write_reports(records: list[FigureRecord], out: Path) -> None:
+    """Write ``report.md``, ``report.html`` and ``summary.json`` for ``records`` (every figure
+    the folder holds, in paper order), each file atomically."""
+    from ..io import write_file
+    write_file(out / "report.md", markdown(records, out), "out")
+    write_file(out / "report.html", html_page(records, out), "out")
+    summary = {"format": SUMMARY_FORMAT, "figures": [r.to_dict() for r in records],
+               "gap_evidence": evidence_of(records)}
+    write_file(out / "summary.json", json.dumps(summary, indent=1), "out")
+
+
+def load_summary(out: Path) -> dict[str, FigureRecord]:
+    """The figure records of an earlier run into ``out`` (``summary.json``), by id; empty when
+    there is none or it cannot be read (the report then starts afresh)."""
+    try:
+        summary = json.loads((out / "summary.json").read_text(encoding="utf-8"))
+        if summary.get("format") != SUMMARY_FORMAT:
+            return {}
+        recs = [FigureRecord.from_dict(d, out) for d in summary["figures"]]
+    except (OSError, ValueError, KeyError, TypeError, AttributeError):
+        return {}
+    return {r.id: r for r in recs if r.id in FIGURES}
 
 
 def platform_text() -> str:

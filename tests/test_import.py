@@ -1,0 +1,114 @@
+"""Importing the package is cheap and has no side effects (each check in a fresh interpreter)."""
+
+import os
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import nonsmooth as ns
+
+HEAVY = ("numba", "xarray", "matplotlib", "scipy")
+
+
+def _python(code: str, **env) -> subprocess.CompletedProcess:
+    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300,
+                       env={**os.environ, **env})
+    assert r.returncode == 0, r.stderr
+    return r
+
+
+def _loaded(code: str) -> set:
+    out = _python(code + "\nimport sys; print(' '.join(sorted(sys.modules)))").stdout
+    return {m.split(".")[0] for m in out.split()}
+
+
+def test_import_loads_no_heavy_module():
+    assert not _loaded("import nonsmooth").intersection(HEAVY)
+
+
+def test_cli_help_and_version_load_no_heavy_module():
+    for arg in ("--help", "--version", "simulate --help"):
+        code = (f"from nonsmooth.cli import main\ntry:\n    main({arg.split()!r})\n"
+                f"except SystemExit as e:\n    assert e.code in (0, None)")
+        assert not _loaded(code).intersection(HEAVY), arg
+
+
+def test_every_public_name_resolves():
+    for name in ns.__all__:
+        assert getattr(ns, name) is not None, name
+        assert name in dir(ns)
+    for mod in ("io", "plot", "errors", "status"):
+        assert getattr(ns, mod).__name__ == f"nonsmooth.{mod}"
+    assert ns.ParameterError is ns.errors.ParameterError
+
+
+def test_simulate_stays_the_function_when_its_module_is_imported_first():
+    # analyses import the module nonsmooth.simulate; the package attribute is the function
+    r = _python("import nonsmooth.simulate, types, nonsmooth as ns\n"
+                "assert not isinstance(ns.simulate, types.ModuleType), ns.simulate\n"
+                "from nonsmooth import simulate\nassert simulate is ns.simulate")
+    assert r.returncode == 0
+
+
+def test_plot_package_leaves_the_backend_and_pyplot_alone(tmp_path):
+    code = ("import matplotlib\nmatplotlib.use('svg')\nimport sys, nonsmooth.plot\n"
+            "from nonsmooth.plot.common import new_figure\nfrom nonsmooth.io import save_figure\n"
+            "fig, ax = new_figure()\nax.plot([0, 1], [1, 0])\n"
+            f"p = save_figure(fig, {str(tmp_path / 'f.png')!r})\n"
+            "for name in nonsmooth.plot.__all__:\n    getattr(nonsmooth.plot, name)\n"
+            "assert 'matplotlib.pyplot' not in sys.modules\n"
+            "assert matplotlib.get_backend() == 'svg', matplotlib.get_backend()\nprint(p)")
+    r = _python(code, MPLBACKEND="")
+    assert r.stdout.strip() == str(tmp_path / "f.png")
+    assert (tmp_path / "f.png").read_bytes()[:4] == b"\x89PNG"
+
+
+def test_plot_functions_are_found_from_nonsmooth_plot():
+    import nonsmooth.plot as nplot
+    for name in ("plot_time_response", "plot_poincare", "plot_bifurcation", "plot_resonance",
+                 "plot_eta_study", "plot_basins", "plot_attractors"):
+        assert callable(getattr(nplot, name)) and name in dir(nplot)
+
+
+def test_python_dash_m_nonsmooth():
+    r = subprocess.run([sys.executable, "-m", "nonsmooth", "--version"], capture_output=True,
+                       text=True, timeout=120)
+    assert r.returncode == 0 and r.stdout.strip() == f"nonsmooth {ns.__version__}"
+
+
+def test_numba_cache_of_other_libraries_is_untouched(tmp_path):
+    # another numba library, imported after nonsmooth's kernels: numba's own CACHE_DIR and
+    # locators (its __pycache__ beside the source) still apply to it
+    (tmp_path / "otherlib.py").write_text(
+        "import numba\n@numba.njit(cache=True)\ndef f(x):\n    return x + 1\n")
+    code = ("import numba\nbefore = numba.config.CACHE_DIR\n"
+            "import nonsmooth.integrate, nonsmooth.models, nonsmooth.analysis\n"
+            "import otherlib\nassert otherlib.f(1) == 2\n"
+            "assert numba.config.CACHE_DIR == before, numba.config.CACHE_DIR")
+    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300,
+                       cwd=tmp_path, env={**os.environ, "PYTHONPATH": str(tmp_path)})
+    assert r.returncode == 0, r.stderr
+    assert list((tmp_path / "__pycache__").glob("otherlib.f-*.nbi"))
+
+
+def test_source_digest_covers_the_kernels_only(tmp_path):
+    # a copy of the package: editing a plot label keeps the digest, editing a kernel changes it
+    src = Path(ns.__file__).parent
+    shutil.copytree(src, tmp_path / "nonsmooth", ignore=shutil.ignore_patterns("__pycache__"))
+    digest = ("import nonsmooth._numba_cache as c; "
+              "assert c.ROOT == __import__('pathlib').Path(c.__file__).parent; "
+              "print(c.source_digest())")
+
+    def current():
+        return _python(digest, PYTHONPATH=str(tmp_path)).stdout.strip()
+
+    d0 = current()
+    with open(tmp_path / "nonsmooth" / "plot" / "common.py", "a") as f:
+        f.write("\n# an edited label\n")
+    with open(tmp_path / "nonsmooth" / "cli" / "common.py", "a") as f:
+        f.write("\n# an edited help text\n")
+    assert current() == d0
+    with open(tmp_path / "nonsmooth" / "integrate" / "record.py", "a") as f:
+        f.write("\n# an edited kernel\n")
+    assert current() != d0
