@@ -149,18 +149,20 @@ def _run_round(method, p, opts, X0, V0, active, max_periods, transient, tol, max
                 cV[i], cxm[i:i + 1], ofs[i], oi8[i], ou8[i])
 
 
+@nb.njit(cache=True, inline="always")
+def _one_interval():
+    """Output buffers of the kernel contract for one interval (X, V, R, M, Xmax, Xmin)."""
+    return (np.empty(1), np.empty(1), np.empty(1, np.int8), np.empty(1, np.uint8), np.empty(1),
+            np.empty(1))
+
+
 @nb.njit(cache=True, parallel=True)
 def _map_points(method, p, opts, states, period, outX, outV, ok):
     """Advance every state by outX.shape[1] times ``period`` forcing periods, recording its
     section point after each (outX[i, j]); rows with ok[i] False are skipped, ok[i] = False if
     the kernel failed."""
     for i in nb.prange(states.shape[0]):
-        ox = np.empty(1)
-        ov = np.empty(1)
-        orr = np.empty(1, np.int8)
-        om = np.empty(1, np.uint8)
-        oxa = np.empty(1)
-        oxi = np.empty(1)
+        ox, ov, orr, om, oxa, oxi = _one_interval()
         for j in range(outX.shape[1]):
             if not ok[i]:
                 break
@@ -188,12 +190,7 @@ def _certify_cells(method, p, opts, cx, cv, rc, todo, nsamp, m_max, apts, arad2,
             _init_state(states[j], cx[k] + rc * math.cos(th), cv[k] + rc * math.sin(th))
         xs = np.empty(nsamp)
         vs = np.empty(nsamp)
-        ox = np.empty(1)
-        ov = np.empty(1)
-        orr = np.empty(1, np.int8)
-        om = np.empty(1, np.uint8)
-        oxa = np.empty(1)
-        oxi = np.empty(1)
+        ox, ov, orr, om, oxa, oxi = _one_interval()
         for m in range(m_max):
             bad = False
             for j in range(nsamp):
