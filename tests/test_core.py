@@ -8,8 +8,8 @@ from scipy.integrate import solve_ivp
 
 import nonsmooth as ns
 from nonsmooth.integrate import tableau as tb
-from nonsmooth.integrate.rkf45 import fixed_step
-from nonsmooth.models import switch as sw
+from nonsmooth.models.support.smooth_kernel import fixed_step
+from nonsmooth.models.support import switch as sw
 from oracles import linear_solution, steady_amplitude
 
 FREE = ns.Params(omega0=1.0, omega_s=10.0, xi=0.05, xi_s=0.3, F0=0.05, omega=0.8, eta=1e-4)

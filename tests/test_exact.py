@@ -20,7 +20,7 @@ from scipy.integrate import solve_ivp
 from nonsmooth import Params, Solver, preset
 from nonsmooth import status as st
 from nonsmooth.integrate.contract import ST_MODE
-from nonsmooth.integrate.exact import advance_exact
+from nonsmooth.models.support.exact_kernel import advance_exact
 from nonsmooth.kernels import METHOD_EXACT, advance, new_state, output_buffers
 
 EXACT = Solver(method="exact")

@@ -126,7 +126,7 @@ def test_bifurcation_summary_counts_each_point_once(tmp_path):
 
 
 def test_integrator_text_follows_the_code():
-    from nonsmooth.integrate import rkf45
+    from nonsmooth.integrate import rkstep as rkf45
     a = ns.simulate(ns.preset("table1"), periods=1, samples_per_period=2).attrs["integrator"]
     assert "PI" not in a and "elementary" in a and f"{rkf45._SAFETY:g}" in a
 

@@ -1,6 +1,7 @@
 """nonsmooth: nonlinear dynamics of non-smooth mechanical systems.
 
-Public API: :class:`Params`, :func:`preset`, :func:`simulate`, and the analyses.
+Public API: :func:`models`, :func:`model` (a model's ``params(...)``), :class:`Params` (the
+paper's model), :func:`preset`, :func:`simulate`, and the analyses.
 
 Importing the package is cheap and has no side effects: the public names are loaded on first
 use (PEP 562), so numba, xarray, scipy and matplotlib are imported, and the kernels compiled or
@@ -21,6 +22,7 @@ _LAZY = {
     "Params": ".params", "PARAM_NAMES": ".params",
     "preset": ".presets", "PRESETS": ".presets",
     "Solver": ".kernels",
+    "model": ".models",
     "simulate": ".simulate",
     "poincare": ".analysis.poincare",
     "bifurcation_diagram": ".analysis.bifurcation",
@@ -34,7 +36,7 @@ _LAZY = {
 _SUBMODULES = ("analysis", "cli", "errors", "integrate", "io", "kernels", "models", "params",
                "plot", "presets", "reproduction", "status", "sweep")
 
-__all__ = ["__version__", "Params", "PARAM_NAMES", "preset", "PRESETS", "simulate", "reproduce", "Solver",
+__all__ = ["__version__", "Params", "PARAM_NAMES", "model", "models", "preset", "PRESETS", "simulate", "reproduce", "Solver",
            "eta_study", "poincare", "bifurcation_diagram", "resonance_curve", "basins",
            "NonsmoothError", "ParameterError", "OutputError", "IntegrationError"]
 

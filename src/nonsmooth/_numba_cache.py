@@ -73,7 +73,7 @@ def cache_base() -> Path | None:
 
 
 def is_compiled(module: str) -> bool:
-    """True if ``nonsmooth.<module>`` (dotted, e.g. "integrate.rkf45") has cache entries for
+    """True if ``nonsmooth.<module>`` (dotted, e.g. "integrate.hybrid") has cache entries for
     today's kernel sources: used to tell the user once that a first run compiles."""
     base = cache_base()
     if base is None:
@@ -150,7 +150,8 @@ def _kernel_set() -> frozenset:
 
 
 #: Modules whose compilation takes most of a first run's wait.
-SLOW_MODULES = ("integrate.rkf45", "integrate.exact", "kernels")
+SLOW_MODULES = ("models.support.smooth_kernel", "models.support.exact_kernel", "integrate.hybrid",
+                "kernels")
 
 #: Called once, without arguments, when the kernels are first imported and the cache lacks
 #: today's ``SLOW_MODULES`` (compilation follows). The library never prints: the CLI sets

@@ -1,8 +1,12 @@
-"""Method dispatch and solver settings shared by ``simulate`` and every analysis.
+"""Kernel dispatch and solver settings shared by ``simulate`` and every analysis.
 
-Numba cannot cache functions that receive other compiled functions as arguments, so the
-methods are selected by an integer code inside one compiled dispatcher. A new model adds its
-kernel module (implementing :mod:`nonsmooth.integrate.contract`) and one branch here.
+Every analysis core calls :func:`run` with a kernel code and the model's compiled functions
+``fns`` (a tuple of numba first-class functions, see :mod:`nonsmooth.models.base`): the
+generic kernel (:mod:`nonsmooth.integrate.hybrid`) integrates any model from ``fns``; the
+built-in ``support`` model also has specialised kernels with its functions inlined (today's
+speed), selected by their codes. Passing compiled functions as first-class ``FunctionType``
+values keeps every core cacheable on disk (a dispatcher argument would not be). A new model
+needs no edit here.
 """
 
 from __future__ import annotations
@@ -14,19 +18,95 @@ import numba as nb
 import numpy as np
 
 from .errors import ParameterError
-from .integrate.contract import DISPATCH_SIGNATURE, N_OPTS, N_STATE, OPT_ATOL, OPT_MAX_STEPS, OPT_RTOL, OPT_TRANSITION
-from .integrate.exact import advance_exact
-from .integrate.rkf45 import advance_smooth
-from .models.switch import TRANSITIONS
+import warnings
 
-METHOD_SMOOTH = 0
-METHOD_EXACT = 1
+from .integrate.contract import (
+    DISPATCH_SIGNATURE,
+    KERNEL_SIGNATURE,
+    MAX_GUARDS,
+    N_OPTS,
+    N_STATE,
+    OPT_ATOL,
+    OPT_CLOSED_FORM,
+    OPT_MAX_STEPS,
+    OPT_N,
+    OPT_NMEM,
+    OPT_OMEGA,
+    OPT_RTOL,
+    OPT_TRANSITION,
+    ST_EXTRA,
+    ST_MODE,
+    ST_V,
+    ST_X,
+)
+from .integrate.hybrid import advance_generic
+from .models.base import KERNEL_GENERIC, KERNEL_SUPPORT_EXACT, KERNEL_SUPPORT_SMOOTH
+from .models.support.exact_kernel import advance_exact
+from .models.support.smooth_kernel import advance_smooth
+from .models.support.switch import TRANSITIONS, beta_ratio, inside_margin
+from .params import IDX
+
+_I_OMEGA_S = IDX["omega_s"]
+_I_XI_S = IDX["xi_s"]
+_I_ETA = IDX["eta"]
+
+warnings.filterwarnings("ignore", category=nb.NumbaExperimentalFeatureWarning)
+
+#: Kernel codes of the built-in support model's methods (kept for today's callers).
+METHOD_SMOOTH = KERNEL_SUPPORT_SMOOTH
+METHOD_EXACT = KERNEL_SUPPORT_EXACT
 METHODS = {"smooth": METHOD_SMOOTH, "exact": METHOD_EXACT}
 
 
 @nb.njit(DISPATCH_SIGNATURE, cache=True)
+def run(kernel, fns, p, opts, state, per_period, n_skip, n_out, X, V, R, M, Xmax, Xmin):
+    """Run kernel ``kernel`` (a code of ``models.base``) on the model functions ``fns`` (see
+    ``integrate.contract``); returns its status."""
+    if kernel == KERNEL_GENERIC:
+        return advance_generic(fns, p, opts, state, per_period, n_skip, n_out, X, V, R, M,
+                               Xmax, Xmin)
+    if kernel == KERNEL_SUPPORT_EXACT:
+        return advance_exact(p, opts, state, per_period, n_skip, n_out, X, V, R, M, Xmax, Xmin)
+    return advance_smooth(p, opts, state, per_period, n_skip, n_out, X, V, R, M, Xmax, Xmin)
+
+
+@nb.njit(cache=True)
+def mode_holds(kernel, fns, p, opts, state):
+    """Does the mode carried in ``state`` still hold for parameters ``p`` (at t = 0)? Used
+    after a parameter change in a continuation sweep: mode borders move with parameters."""
+    mode = int(state[ST_MODE])
+    if kernel == KERNEL_SUPPORT_SMOOTH:
+        r = beta_ratio(p[_I_OMEGA_S], p[_I_XI_S])
+        return inside_margin(mode, state[ST_X], state[ST_V], p[_I_ETA], r) >= 0.0
+    if kernel != KERNEL_GENERIC:
+        return True
+    n = int(opts[OPT_N])
+    nm = int(opts[OPT_NMEM])
+    u = np.empty(n)
+    u[0] = state[ST_X]
+    u[1] = state[ST_V]
+    for i in range(2, n):
+        u[i] = state[ST_EXTRA + i - 2]
+    mem = np.empty(max(nm, 1))
+    for i in range(nm):
+        mem[i] = state[ST_EXTRA + n - 2 + i]
+    pp = np.empty(p.shape[0])
+    pp[:] = p
+    G = np.empty((MAX_GUARDS, n + 3))
+    ng = fns[2](mode, pp, mem, G)
+    for k in range(ng):
+        g = G[k, n] + G[k, n + 1]
+        for i in range(n):
+            g += G[k, i] * u[i]
+        if g < 0.0:
+            return False
+    return True
+
+
+@nb.njit(KERNEL_SIGNATURE.return_type(nb.int64, *KERNEL_SIGNATURE.args), cache=True)
 def advance(method, p, opts, state, per_period, n_skip, n_out, X, V, R, M, Xmax, Xmin):
-    """Run the kernel of ``method`` (see ``integrate.contract``); returns its status."""
+    """The support model's kernels by method code (``METHOD_SMOOTH``/``METHOD_EXACT``), as
+    before the model interface; returns the status."""
     if method == METHOD_EXACT:
         return advance_exact(p, opts, state, per_period, n_skip, n_out, X, V, R, M, Xmax, Xmin)
     return advance_smooth(p, opts, state, per_period, n_skip, n_out, X, V, R, M, Xmax, Xmin)
@@ -34,19 +114,25 @@ def advance(method, p, opts, state, per_period, n_skip, n_out, X, V, R, M, Xmax,
 
 @dataclass(frozen=True)
 class Solver:
-    """How trajectories are computed: ``method`` "smooth" (switch model, RKF45) or "exact"
-    (event-driven closed form, eta = 0); tolerances; ``transition`` "eq13" (paper) or "eq12"
-    (convex combinations); ``max_steps`` per forcing period before giving up."""
+    """How trajectories of ``model`` (default: the paper's ``support``) are computed:
+    ``method`` "smooth" (switch model, RKF45) or "exact" (non-smooth, event-driven);
+    tolerances; ``transition`` "eq13" (paper) or "eq12" (convex combinations; support model
+    only); ``max_steps`` per forcing period before giving up."""
 
     method: str = "smooth"
     rtol: float = 1e-8
     atol: float = 1e-10
     transition: str = "eq13"
     max_steps: int = 200_000
+    model: object = None
 
     def __post_init__(self):
-        if self.method not in METHODS:
-            raise ParameterError(f"method: unknown method {self.method!r} (known: {', '.join(METHODS)})")
+        from .models import model as get_model
+        object.__setattr__(self, "model", get_model(self.model or "support"))
+        self.model.method(self.method)  # one-line error for an unknown method
+        if self.transition != "eq13" and self.model.name != "support":
+            raise ParameterError(f"transition: only the support model has the eq12/eq13 "
+                                 f"variants (model {self.model.name!r})")
         if self.transition not in TRANSITIONS:
             raise ParameterError(
                 f"transition: unknown transition {self.transition!r} (known: {', '.join(TRANSITIONS)})")
@@ -58,41 +144,71 @@ class Solver:
             raise ParameterError(f"max_steps: must be a positive integer, got {self.max_steps!r}")
 
     @property
+    def spec(self):
+        """The model's :class:`~nonsmooth.models.base.Method` of this solver."""
+        return self.model.method(self.method)
+
+    @property
     def code(self) -> int:
-        return METHODS[self.method]
+        """Kernel code for :func:`run`."""
+        return self.spec.kernel
+
+    @property
+    def fns(self) -> tuple:
+        """The model's compiled functions for :func:`run` (compiled once, cached)."""
+        return self.model.fns(self.method)
 
     def opts(self) -> np.ndarray:
+        m = self.spec
         o = np.zeros(N_OPTS)
-        o[OPT_RTOL] = self.rtol
-        o[OPT_ATOL] = self.atol
+        o[OPT_RTOL] = self.rtol if m.rtol is None else min(self.rtol, m.rtol)
+        o[OPT_ATOL] = self.atol if m.atol is None else min(self.atol, m.atol)
         o[OPT_MAX_STEPS] = self.max_steps
         o[OPT_TRANSITION] = TRANSITIONS[self.transition]
+        o[OPT_OMEGA] = self.model.index[self.model.omega]
+        o[OPT_N] = self.model.n
+        o[OPT_NMEM] = self.model.n_memory
+        o[OPT_CLOSED_FORM] = 1.0 if m.closed_form else 0.0
         return o
 
     def attrs(self) -> dict:
-        a = {"method": self.method, "rtol": float(self.rtol), "atol": float(self.atol),
-             "max_steps_per_period": int(self.max_steps)}
-        if self.method == "smooth":
+        m = self.spec
+        o = self.opts()
+        a = {"model": self.model.name, "method": self.method, "rtol": float(o[OPT_RTOL]),
+             "atol": float(o[OPT_ATOL]), "max_steps_per_period": int(self.max_steps)}
+        if self.model.name == "support" and self.method == "smooth":
             a["transition"] = self.transition
             a["integrator"] = smooth_integrator()
-        else:
+        elif self.model.name == "support":
             a["integrator"] = "closed form between located switching events"
+        else:
+            a["integrator"] = m.description or generic_integrator(m.closed_form)
         return a
 
 
 def smooth_integrator() -> str:
     """Description of the smoothed-model integrator, read from the constants of the code that
-    runs (``integrate.rkf45``: propagated order, step-size controller)."""
-    from .integrate import rkf45 as k
+    runs (``integrate.rkstep``: propagated order, step-size controller)."""
+    from .integrate import rkstep as k
     q = k.RKF45_ORDER
     return (f"RKF45 (order-{q + 1} propagation, elementary step-size control "
             f"h_new = {k._SAFETY:g} h err^(-{k._EXPO:g}) limited to [{k._FAC_MIN:g}, "
             f"{k._FAC_MAX:g}] h, located switches)")
 
 
-def new_state(x0: float, v0: float) -> np.ndarray:
-    """Initial kernel state (mode classified by the kernel, step size chosen by it)."""
+def generic_integrator(closed_form: bool) -> str:
+    """Description of the generic kernel's integration."""
+    base = smooth_integrator().replace(", located switches)", ", located switches and resets)")
+    if closed_form:
+        return "closed form for linear modes, else " + base
+    return base
+
+
+def new_state(x0: float, v0: float, extra=()) -> np.ndarray:
+    """Initial kernel state (mode classified by the kernel, step size chosen by it);
+    ``extra`` = u[2:] of a model with more than two state components."""
     s = np.zeros(N_STATE)
+    s[ST_EXTRA:ST_EXTRA + len(extra)] = extra
     s[0] = x0
     s[1] = v0
     s[2] = v0

@@ -12,6 +12,7 @@ from dataclasses import asdict, dataclass, fields, replace as _dc_replace
 import numpy as np
 
 from .errors import ParameterError
+from .models.base import ParamsBase
 
 #: Order of the packed parameter array handed to kernels.
 PARAM_NAMES = ("omega0", "omega_s", "xi", "xi_s", "F0", "omega", "eta")
@@ -42,7 +43,7 @@ def _check_finite(name: str, value) -> float:
 
 
 @dataclass(frozen=True)
-class Params:
+class Params(ParamsBase):
     """Non-dimensional parameters of the oscillator with a discontinuous support (eq. 3).
 
     omega0^2 = k/m, omega_s^2 = k_s/m, xi = c/m, xi_s = c_s/m, F0 = f0/(m g); ``omega`` is the
@@ -118,6 +119,12 @@ class Params:
                 f"{unknown[0]}: unknown parameter (known: {', '.join(PARAM_NAMES)})")
         return _dc_replace(self, **changes)
 
+    @property
+    def model(self):
+        """The model these parameters belong to (``support``)."""
+        from .models import model
+        return model("support")
+
     # -- views ----------------------------------------------------------------------------
     def pack(self) -> np.ndarray:
         """float64 array in :data:`PARAM_NAMES` order, for the compiled kernels."""
@@ -160,8 +167,12 @@ class Params:
         return cls(**values)
 
 
-def check_param_name(name: str) -> str:
-    """Return ``name`` if it is a parameter name, else raise a one-line ParameterError."""
+def check_param_name(name: str, params=None) -> str:
+    """Return ``name`` if it is a parameter name (of ``params``' model; default the support
+    model), else raise a one-line ParameterError."""
+    if params is not None and params.model.name != "support":
+        params.model.param(name)
+        return name
     if name not in PARAM_NAMES:
         raise ParameterError(f"{name}: unknown parameter (known: {', '.join(PARAM_NAMES)})")
     return name

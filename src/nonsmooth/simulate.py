@@ -13,7 +13,7 @@ from .errors import IntegrationError, ParameterError
 from .integrate.contract import ST_MODE
 from .io import provenance_attrs
 from .kernels import Solver, new_state
-from .params import Params
+from .models.base import ParamsBase
 
 
 def check_int(name: str, value, minimum: int) -> int:
@@ -38,9 +38,12 @@ def check_float(name: str, value) -> float:
     return v
 
 
-def check_params(params) -> Params:
-    if not isinstance(params, Params):
-        raise ParameterError(f"params: expected nonsmooth.Params, got {type(params).__name__}")
+def check_params(params) -> ParamsBase:
+    """``params`` if it is a model's validated parameters (``nonsmooth.Params`` or
+    ``model.params(...)``), else a one-line ParameterError."""
+    if not isinstance(params, ParamsBase):
+        raise ParameterError(f"params: expected nonsmooth.Params or model(...).params(...), "
+                             f"got {type(params).__name__}")
     return params
 
 
@@ -50,7 +53,8 @@ def start_trajectory(params, x0, v0, method, rtol, atol, transition):
     params = check_params(params)
     x0 = check_float("x0", x0)
     v0 = check_float("v0", v0)
-    solver = Solver(method=method, rtol=rtol, atol=atol, transition=transition)
+    solver = Solver(method=method, rtol=rtol, atol=atol, transition=transition,
+                    model=params.model)
     return params, solver, params.pack(), solver.opts(), new_state(x0, v0)
 
 
@@ -105,7 +109,6 @@ def simulate(params: Params, *, periods: int, transient: int = 0,
     time slices; ``progress(done, total)`` (in forcing periods) is called between them.
     """
     from .io import check_memory, flag_attrs, format_bytes
-    from .models.switch import REGION_NAMES
     from .sweep import run_trajectories
     params, solver, p, opts, state = start_trajectory(params, x0, v0, method, rtol, atol,
                                                       transition)
@@ -140,8 +143,9 @@ def simulate(params: Params, *, periods: int, transient: int = 0,
     T = params.period
     t0 = transient * T
     t = t0 + np.arange(n + 1) * (T / spp)
-    regions = flag_attrs(REGION_NAMES, dtype=np.int8)
-    masks = flag_attrs(REGION_NAMES, dtype=np.uint8, masks=True)
+    modes = params.model.mode_names
+    regions = flag_attrs(modes, dtype=np.int8)
+    masks = flag_attrs(modes, dtype=np.uint8, masks=True)
     ds = xr.Dataset(
         {
             "X": ("t", X, {"long_name": "displacement X = x/g", "units": "1"}),

@@ -16,22 +16,22 @@ import numba as nb
 import numpy as np
 
 from .errors import ParameterError
-from .kernels import Solver, advance
-from .integrate.contract import N_STATE
+from .kernels import Solver, run
+from .integrate.contract import MODEL_FNS_TYPE, N_STATE
 
 
 _F2 = nb.float64[:, :]
 #: one signature (any layout): time slices of the outputs are non-contiguous views
-_RUN_MANY_SIG = nb.void(nb.int64, _F2, nb.float64[:], _F2, nb.int64, nb.int64, nb.int64, _F2, _F2,
+_RUN_MANY_SIG = nb.void(nb.int64, MODEL_FNS_TYPE, _F2, nb.float64[:], _F2, nb.int64, nb.int64, nb.int64, _F2, _F2,
                         nb.int8[:, :], nb.uint8[:, :], _F2, _F2, nb.int64[:])
 
 
 @nb.njit(_RUN_MANY_SIG, cache=True, parallel=True)
-def _run_many(method, P, opts, states, per_period, n_skip, n_out, X, V, R, M, Xmax, Xmin, status):
+def _run_many(method, fns, P, opts, states, per_period, n_skip, n_out, X, V, R, M, Xmax, Xmin, status):
     """One slice of every trajectory whose ``status`` is still 0 (failed ones are skipped)."""
     for i in nb.prange(P.shape[0]):
         if status[i] == 0:
-            status[i] = advance(method, P[i], opts, states[i], per_period, n_skip, n_out,
+            status[i] = run(method, fns, P[i], opts, states[i], per_period, n_skip, n_out,
                                 X[i], V[i], R[i], M[i], Xmax[i], Xmin[i])
 
 
@@ -119,7 +119,7 @@ def run_trajectories(P, solver: Solver, states, *, per_period: int, n_skip: int,
                 o0, o1 = max(k, n_skip) - n_skip, k + m - n_skip
                 o1 = max(o0, o1)
                 slicer.run(lambda _size: _run_many(
-                    solver.code, P[a:b], opts, states[a:b], per_period, skip, o1 - o0,
+                    solver.code, solver.fns, P[a:b], opts, states[a:b], per_period, skip, o1 - o0,
                     out["X"][a:b, o0:o1], out["V"][a:b, o0:o1], out["R"][a:b, o0:o1],
                     out["M"][a:b, o0:o1], out["Xmax"][a:b, o0:o1], out["Xmin"][a:b, o0:o1],
                     out["status"][a:b]))

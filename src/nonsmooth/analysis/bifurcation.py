@@ -22,33 +22,27 @@ import xarray as xr
 from .. import status as st
 from ..errors import ParameterError
 from ..io import provenance_attrs
-from ..kernels import METHOD_SMOOTH, Solver, advance
-from ..models.switch import beta_ratio, inside_margin
-from ..params import IDX, PARAM_INFO, Params, check_param_name
+from ..integrate.contract import MODEL_FNS_TYPE
+from ..kernels import Solver, mode_holds, run
+from ..params import Params, check_param_name
 from .poincare import MAX_PERIOD, PERIOD_LONG_NAME, SETTLE_WINDOW, classify, settle, settle_tolerance
 
 SWEEPS = ("up", "down", "both", "fresh")
 
-_I_OMEGA_S = IDX["omega_s"]
-_I_XI_S = IDX["xi_s"]
-_I_ETA = IDX["eta"]
-
 
 @nb.njit(cache=True)
-def _fix_mode(method, p, state):
-    """After a parameter change, reclassify the region if the carried one no longer holds
-    (band borders move with eta, omega_s, xi_s). The entry velocity Va is kept."""
-    if method == METHOD_SMOOTH and state[3] >= 0:
-        r = beta_ratio(p[_I_OMEGA_S], p[_I_XI_S])
-        if inside_margin(int(state[3]), state[0], state[1], p[_I_ETA], r) < 0.0:
-            state[3] = -1.0
+def _fix_mode(method, fns, p, opts, state):
+    """After a parameter change, reclassify the mode if the carried one no longer holds
+    (mode borders move with the parameters). The memory is kept where the mode holds."""
+    if state[3] >= 0 and not mode_holds(method, fns, p, opts, state):
+        state[3] = -1.0
 
 
 _F3 = nb.float64[:, :, :]
 _I8_2 = nb.int64[:, :]
 #: one signature (any layout): chunks of the value axis are non-contiguous views, whole small
 #: sweeps are contiguous; without it numba would compile and cache both versions
-_CONTINUATION_SIG = nb.void(nb.int64, _F3, nb.float64[:], nb.float64[:, :], nb.float64[:], nb.int64,
+_CONTINUATION_SIG = nb.void(nb.int64, MODEL_FNS_TYPE, _F3, nb.float64[:], nb.float64[:, :], nb.float64[:], nb.int64,
                             nb.float64, _F3, _F3, nb.int8[:, :, :], nb.uint8[:, :, :], _F3, _F3,
                             _I8_2, _I8_2, _F3, _I8_2, nb.int64)
 
@@ -60,7 +54,7 @@ _START, _SETTLE, _RECORD = 0, 1, 2
 
 
 @nb.njit(_CONTINUATION_SIG, cache=True, parallel=True)
-def continuation(method, P, opts, states, init, transient, settle_tol,
+def continuation(method, fns, P, opts, states, init, transient, settle_tol,
                  X, V, R, M, Xmax, Xmin, status, used, S, prog, budget):
     """For every branch b (in parallel) and parameter row i (in order): continue
     ``states[b]`` with parameters ``P[b, i]`` for ``transient`` periods (ended early when
@@ -79,14 +73,14 @@ def continuation(method, P, opts, states, init, transient, settle_tol,
         while prog[b, PG_VALUE] < ni and work < budget:
             i = prog[b, PG_VALUE]
             if prog[b, PG_PHASE] == _START:
-                _fix_mode(method, P[b, i], states[b])
+                _fix_mode(method, fns, P[b, i], opts, states[b])
                 prog[b, PG_DONE] = 0
                 prog[b, PG_REC] = 0
                 prog[b, PG_PHASE] = _SETTLE
             code = 0
             if prog[b, PG_PHASE] == _SETTLE:
                 d0 = prog[b, PG_DONE]
-                code, d, fin = settle(method, P[b, i], opts, states[b], transient, settle_tol,
+                code, d, fin = settle(method, fns, P[b, i], opts, states[b], transient, settle_tol,
                                       d0, budget - work)
                 work += d - d0
                 prog[b, PG_DONE] = d
@@ -95,7 +89,7 @@ def continuation(method, P, opts, states, init, transient, settle_tol,
             if code == 0 and prog[b, PG_PHASE] == _RECORD and (work < budget or nrec == 0):
                 r = prog[b, PG_REC]
                 n = min(nrec - r, max(budget - work, 1))
-                code = advance(method, P[b, i], opts, states[b], 1, 0, n, X[b, i, r:r + n],
+                code = run(method, fns, P[b, i], opts, states[b], 1, 0, n, X[b, i, r:r + n],
                                V[b, i, r:r + n], R[b, i, r:r + n], M[b, i, r:r + n],
                                Xmax[b, i, r:r + n], Xmin[b, i, r:r + n])
                 work += n
@@ -145,7 +139,7 @@ def param_rows(params: Params, param: str, values) -> np.ndarray:
     for x in (values.min(), values.max()):
         params.replace(**{param: float(x)})
     rows = np.tile(params.pack(), (values.size, 1))
-    rows[:, IDX[param]] = values
+    rows[:, params.model.index[param]] = values
     return rows
 
 
@@ -182,7 +176,7 @@ def follow(P, solver: Solver, states, init, transient: int, settle_tol: float, r
             args = [v[a:b] for v in (out["X"], out["V"], out["R"], out["M"], out["Xmax"],
                                      out["Xmin"], out["status"], out["used"], out["S"])]
             while np.any(prog[a:b, PG_VALUE] < nval):
-                sl.run(lambda size: continuation(solver.code, P[a:b], opts, states[a:b], init,
+                sl.run(lambda size: continuation(solver.code, solver.fns, P[a:b], opts, states[a:b], init,
                                                  transient, settle_tol, *args, prog[a:b], size))
                 if progress is not None:
                     g = prog[:b]
@@ -251,12 +245,21 @@ def summarize(out, rows, solver: Solver, transient: int, record: int, workers=No
     extra = np.zeros(shape, np.int64)
     todo = [(j, i) for j in range(shape[0]) for i in range(shape[1])
             if out["status"][j, i] == st.OK]
+    model = solver.model
+    predicates = {}
+
+    def contact_rule(i):  # the model's contact predicate at parameter row i
+        if i not in predicates:
+            prm = model.params(**dict(zip(model.param_names, map(float, rows[i]))))
+            predicates[i] = lambda m, a, b: model.is_contact(prm, m, a, b)
+        return predicates[i]
+
     for rnd in range(MAX_ROUNDS + 1):
         pending = {}  # extension (a power of 2 periods, at least ``record``) -> points
         for j, i in todo:
             period[j, i], mx[j, i], mn[j, i], contact[j, i], need = classify(
                 out["X"][j, i], out["V"][j, i], out["Xmax"][j, i], out["Xmin"][j, i],
-                out["M"][j, i], solver.rtol, solver.atol)
+                out["M"][j, i], solver.rtol, solver.atol, contact=contact_rule(i))
             if need > 0 and rnd < MAX_ROUNDS and extra[j, i] + record + need <= cap:
                 ext = max(record, 1 << int(math.ceil(math.log2(1.5 * need))))
                 ext = min(ext, cap - int(extra[j, i]) - record)
@@ -311,7 +314,7 @@ def bifurcation_diagram(params: Params, param: str, values, *, sweep: str = "bot
     params = check_params(params)
     if not isinstance(param, str):
         raise ParameterError(f"param: expected a parameter name, got {param!r}")
-    param = check_param_name(param)
+    param = check_param_name(param, params)
     if sweep not in SWEEPS:
         raise ParameterError(f"sweep: unknown sweep {sweep!r} (known: {', '.join(SWEEPS)})")
     transient = check_int("transient", transient, 0)
@@ -320,7 +323,7 @@ def bifurcation_diagram(params: Params, param: str, values, *, sweep: str = "bot
     values = check_values(param, values)
     x0 = check_float("x0", x0)
     v0 = check_float("v0", v0)
-    solver = Solver(method=method, rtol=rtol, atol=atol, transition=transition,
+    solver = Solver(model=params.model, method=method, rtol=rtol, atol=atol, transition=transition,
                     max_steps=max_steps)
     directions = {"up": ["up"], "down": ["down"], "both": ["up", "down"], "fresh": ["fresh"]}[sweep]
     out = run_branches(params, param, values, solver, directions=directions,
@@ -342,7 +345,8 @@ def branches_dataset(params, param, values, solver, directions, out, *, workers=
     rows = param_rows(params, param, values)
     period, mx, mn, contact = summarize(out, rows, solver, attrs["transient"], attrs["record"],
                                         workers)
-    desc, unit, _ = PARAM_INFO[param]
+    spec = params.model.param(param)
+    desc, unit = spec.long_name, spec.units
     dims = ("sweep", param)
     nfail = int(np.count_nonzero(out["status"]))
     ds = xr.Dataset(

@@ -38,8 +38,7 @@ import xarray as xr
 from ..errors import ParameterError
 from ..io import provenance_attrs
 from ..kernels import Solver, new_state
-from ..models.switch import GAMMA_PLUS
-from ..params import Params
+from ..models.base import ParamsBase as Params
 from ..sweep import run_trajectories
 from .periodicity import detect_period, section_tolerance
 
@@ -136,10 +135,13 @@ def eta_study(params: Params, etas, *, transient: int = 300, record: int | None 
     * ``recommended_eta``: the largest eta that agrees with the exact model (NaN if none).
     """
     from ..io import check_memory, flag_attrs, status_flags
-    from ..models.switch import REGION_NAMES
+    from ..simulate import check_params
     from ..simulate import renamed
-    if not isinstance(params, Params):
-        raise ParameterError(f"params: expected nonsmooth.Params, got {type(params).__name__}")
+    params = check_params(params)
+    if "eta" not in params.model.param_names or set(params.model.methods) != {"smooth", "exact"}:
+        raise ParameterError(f"params: eta_study needs a model with a band eta and both methods "
+                             f"(model {params.model.name!r})")
+    full = params.model.contact_modes  # the modes of full contact (support: Gamma+)
     eta_vals = check_etas(etas)
     record = renamed("record", record, "points", points, default=200)
     orbit_periods = renamed("orbit_periods", orbit_periods, "portrait_periods",
@@ -157,8 +159,9 @@ def eta_study(params: Params, etas, *, transient: int = 300, record: int | None 
     n = len(eta_vals)
     check_memory(34.0 * (n + 1) * (record + orbit_periods * spp), "record",
                  "record fewer section points, orbit periods or samples per period")
-    smooth = Solver(method="smooth", rtol=rtol, atol=atol, transition=transition)
-    exact = Solver(method="exact")
+    smooth = Solver(method="smooth", rtol=rtol, atol=atol, transition=transition,
+                    model=params.model)
+    exact = Solver(method="exact", model=params.model)
 
     total = (n + 1) * (transient + record + orbit_periods)
 
@@ -177,7 +180,7 @@ def eta_study(params: Params, etas, *, transient: int = 300, record: int | None 
     # ---- exact reference ----
     eX, eV = esec["X"][0], esec["V"][0]
     e_ok = int(estatus[0]) == 0
-    e_contact = int(bool(np.any(esec["M"][0] & (1 << GAMMA_PLUS)))) if e_ok else 0
+    e_contact = int(bool(np.any(esec["M"][0] & full))) if e_ok else 0
     e_period = _period(eX, eV, EXACT_RTOL, EXACT_ATOL) if e_ok else 0
     h = record // 2
     e_self = set_distance(eX[:h], eV[:h] / om, eX[h:], eV[h:] / om) if e_ok else float("nan")
@@ -195,7 +198,7 @@ def eta_study(params: Params, etas, *, transient: int = 300, record: int | None 
             continue
         X, V, M = sec["X"][i], sec["V"][i], sec["M"][i]
         visited[i] = np.bitwise_or.reduce(M)
-        reach[i] = int(bool(visited[i] & (1 << GAMMA_PLUS)))
+        reach[i] = int(bool(visited[i] & full))
         period[i] = _period(X, V, rtol, atol)
         if e_ok:
             dist[i] = set_distance(X, V / om, eX, eV / om)
@@ -207,8 +210,8 @@ def eta_study(params: Params, etas, *, transient: int = 300, record: int | None 
     T = params.period
     t_sec = (transient + np.arange(1, record + 1)) * T
     t_orb = (transient + record) * T + np.arange(1, orbit_periods * spp + 1) * (T / spp)
-    regions = flag_attrs(REGION_NAMES, dtype=np.int8)
-    masks = flag_attrs(REGION_NAMES, dtype=np.uint8, masks=True)
+    regions = flag_attrs(params.model.mode_names, dtype=np.int8)
+    masks = flag_attrs(params.model.mode_names, dtype=np.uint8, masks=True)
     yes_no = flag_attrs(("no", "yes"), dtype=np.int8)
     period_attrs = {"long_name": "period of the section points in forcing periods "
                                  "(0 = none)", "units": "1"}

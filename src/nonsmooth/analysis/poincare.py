@@ -54,7 +54,7 @@ from .. import status as st
 from ..errors import IntegrationError
 from ..integrate.contract import ST_MODE
 from ..io import provenance_attrs
-from ..kernels import Solver, advance
+from ..kernels import Solver, run
 from ..params import Params
 from .periodicity import NOT_SETTLED, detect_period, section_tolerance, still_converging
 
@@ -106,7 +106,7 @@ def _settled(X, V, tol, pmax):
 
 
 @nb.njit(cache=True)
-def settle(method, p, opts, state, transient, settle_tol, done, budget):
+def settle(method, fns, p, opts, state, transient, settle_tol, done, budget):
     """Continue a transient of ``transient`` forcing periods of which ``done`` are integrated
     (``state`` is updated), for about ``budget`` more periods: whole settle windows (at least
     one), so that a transient cut into such calls is identical to one call. ``settle_tol > 0``
@@ -115,7 +115,7 @@ def settle(method, p, opts, state, transient, settle_tol, done, budget):
     if settle_tol <= 0.0 or transient < SETTLE_WINDOW:
         n = max(0, min(budget, transient - done))
         e0 = np.empty(0)
-        code = advance(method, p, opts, state, 1, n, 0, e0, e0, np.empty(0, np.int8),
+        code = run(method, fns, p, opts, state, 1, n, 0, e0, e0, np.empty(0, np.int8),
                        np.empty(0, np.uint8), e0, e0)
         done += n
         return code, done, code != 0 or done >= transient
@@ -129,7 +129,7 @@ def settle(method, p, opts, state, transient, settle_tol, done, budget):
     start = done
     while done < transient and (done == start or done - start < budget):
         n = min(w, transient - done)
-        code = advance(method, p, opts, state, 1, 0, n, bx[:n], bv[:n], br[:n], bm[:n],
+        code = run(method, fns, p, opts, state, 1, 0, n, bx[:n], bv[:n], br[:n], bm[:n],
                        b1[:n], b2[:n])
         done += n
         if code != 0:
@@ -148,11 +148,13 @@ def settle_tolerance(solver: Solver, settle: bool) -> float:
     return SETTLE_FRACTION * section_tolerance(solver.rtol, solver.atol) if settle else 0.0
 
 
-def classify(X, V, Xmax, Xmin, M, rtol: float, atol: float, max_period: int = MAX_PERIOD):
+def classify(X, V, Xmax, Xmin, M, rtol: float, atol: float, max_period: int = MAX_PERIOD,
+             contact=None):
     """(period, max_X, min_X, contact, need) of recorded section data (see module docstring).
     ``need`` > 0: the section is still converging (``periodicity.still_converging``), period
     is then NOT_SETTLED and ``need`` estimates the further periods it takes to settle.
-    NaN data give (0, nan, nan, 0, 0)."""
+    ``contact(mask, max_X, min_X)``: the model's contact predicate (default: the support
+    model's). NaN data give (0, nan, nan, 0, 0)."""
     X = np.ascontiguousarray(X, dtype=np.float64)
     V = np.ascontiguousarray(V, dtype=np.float64)
     if X.size == 0 or not (np.all(np.isfinite(X)) and np.all(np.isfinite(V))):
@@ -165,7 +167,12 @@ def classify(X, V, Xmax, Xmin, M, rtol: float, atol: float, max_period: int = MA
         period = NOT_SETTLED
     mx = float(np.max(Xmax))
     mn = float(np.min(Xmin))
-    contact = int(bool(np.any(np.asarray(M) & np.uint8(0b1110))) and mx >= 1.0)
+    mask = int(np.bitwise_or.reduce(np.asarray(M, dtype=np.uint8).ravel())) if np.size(M) else 0
+    if contact is None:
+        hit = bool(mask & 0b1110) and mx >= 1.0
+    else:
+        hit = bool(contact(mask, mx, mn))
+    contact = int(hit)
     return period, mx, mn, contact, need
 
 
@@ -190,7 +197,6 @@ def poincare(params: Params, *, record: int | None = None, transient: int, x0: f
     Raises IntegrationError if the trajectory fails (sweeps record failures instead).
     """
     from ..io import check_memory, flag_attrs, status_flags
-    from ..models.switch import REGION_NAMES
     from ..simulate import check_int, renamed, start_trajectory
     from ..sweep import run_trajectories
     from .bifurcation import follow, summarize
@@ -228,7 +234,7 @@ def poincare(params: Params, *, record: int | None = None, transient: int, x0: f
     oR = np.concatenate([[int(state[ST_MODE])], orb["R"][0]]).astype(np.int8)
 
     T = params.period
-    regions = flag_attrs(REGION_NAMES, dtype=np.int8)
+    regions = flag_attrs(params.model.mode_names, dtype=np.int8)
     ds = xr.Dataset(
         {
             "X": ("n", X, {"long_name": "section displacement X(t_section)", "units": "1"}),

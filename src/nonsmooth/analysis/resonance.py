@@ -185,7 +185,8 @@ def resonance_curve(params: Params, omegas, *, method: str = "smooth", transient
     branch_tol = check_float("branch_tol", branch_tol)
     if branch_tol <= 0:
         raise ParameterError(f"branch_tol: must be > 0, got {branch_tol}")
-    solver = Solver(method=method, rtol=rtol, atol=atol, transition=transition)
+    solver = Solver(method=method, rtol=rtol, atol=atol, transition=transition,
+                    model=params.model)
     out = run_branches(params, "omega", omegas, solver, directions=["up", "down"],
                        transient=transient, record=record, x0=x0, v0=v0, settle=settle,
                        workers=workers, progress=progress)

@@ -20,8 +20,12 @@ print or raise: they return a status code from :mod:`nonsmooth.status`.
 OPT_RTOL = 0
 OPT_ATOL = 1
 OPT_MAX_STEPS = 2  # steps allowed per forcing period, on average over a call
-OPT_TRANSITION = 3  # models.switch.TRANSITION_EQ13 / TRANSITION_EQ12 (smoothed model only)
-N_OPTS = 4
+OPT_TRANSITION = 3  # models.support.switch.TRANSITION_EQ13 / TRANSITION_EQ12 (support, smooth only)
+OPT_OMEGA = 4  # index of the forcing frequency omega in p (generic kernel)
+OPT_N = 5  # state dimension n >= 2 (generic kernel)
+OPT_NMEM = 6  # number of discrete memory slots (generic kernel)
+OPT_CLOSED_FORM = 7  # 1: propagate the modes a model declares linear in closed form (generic)
+N_OPTS = 8
 
 # state layout
 ST_X = 0
@@ -29,7 +33,60 @@ ST_V = 1
 ST_VA = 2  # entry velocity into Sigma_alpha (eq. 13a memory); unused by the exact model
 ST_MODE = 3  # region/mode code; -1 = classify from (X, V) at the start
 ST_H = 4  # step size to try next (adaptive kernels); <= 0 = choose
-N_STATE = 5
+ST_EXTRA = 5  # generic kernel: u[2:n], then the memory mem[0:n_mem]
+N_STATE = 16  # so n - 2 + n_mem <= N_STATE - ST_EXTRA = 11
+
+#: Largest number of switching surfaces (guards) one mode may watch.
+MAX_GUARDS = 8
+
+
+def _quiet_first_class_functions():
+    """First-class functions are "experimental" in numba, and numba warns each time it types a
+    tuple of them, i.e. on every call that passes a model's ``fns`` from Python (with ``-W
+    error`` that call would fail). They are what keeps kernels taking a model's functions
+    cacheable (see ``kernels.py``), so that one warning is silenced where numba emits it."""
+    import functools
+    import warnings
+
+    from numba.core import utils
+
+    original = utils.unified_function_type
+    if getattr(original, "_nonsmooth_quiet", False):
+        return
+
+    @functools.wraps(original)
+    def quiet(*args, **kwargs):
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", category=numba.NumbaExperimentalFeatureWarning)
+            return original(*args, **kwargs)
+
+    import numba
+    quiet._nonsmooth_quiet = True
+    utils.unified_function_type = quiet
+
+
+def _model_signatures():
+    from numba import types as t
+
+    _quiet_first_class_functions()
+
+    i8, f8 = t.int64, t.float64
+    a1 = t.float64[::1]
+    a2 = t.float64[:, ::1]
+    field = i8(i8, f8, f8, f8, a1, a1, a1, a1)
+    jacobian = i8(i8, f8, f8, f8, a1, a1, a1, a2)
+    guards = i8(i8, a1, a1, a2)
+    transition = i8(i8, i8, f8, f8, f8, a1, a1, a1)
+    initial = i8(f8, f8, a1, a1, a1)
+    linear = i8(i8, a1, a1)
+    sigs = (field, jacobian, guards, transition, initial, linear)
+    return sigs, t.Tuple(tuple(t.FunctionType(s) for s in sigs))
+
+
+#: numba signatures of a model's compiled functions (see ``nonsmooth.models.base``), in the
+#: order of the tuple ``fns`` that the generic kernel receives, and the type of that tuple.
+MODEL_SIGNATURES, MODEL_FNS_TYPE = _model_signatures()
+FIELD_SIG, JACOBIAN_SIG, GUARDS_SIG, TRANSITION_SIG, INITIAL_SIG, LINEAR_SIG = MODEL_SIGNATURES
 
 
 def _signatures():
@@ -37,11 +94,12 @@ def _signatures():
 
     f8 = t.float64[:]  # any layout: the kernels touch these arrays once per call or interval
     args = (f8, f8, f8, t.int64, t.int64, t.int64, f8, f8, t.int8[:], t.uint8[:], f8, f8)
-    return t.int64(*args), t.int64(t.int64, *args)
+    return (t.int64(*args), t.int64(MODEL_FNS_TYPE, *args),
+            t.int64(t.int64, MODEL_FNS_TYPE, *args))
 
 
 #: Explicit numba signatures of a kernel and of the method dispatcher. Compiling the kernels
 #: for exactly these types means one machine-code version each: without them numba would
 #: compile (and cache) a new copy of every kernel for each combination of literal integers
 #: that a caller happens to pass.
-KERNEL_SIGNATURE, DISPATCH_SIGNATURE = _signatures()
+KERNEL_SIGNATURE, GENERIC_KERNEL_SIGNATURE, DISPATCH_SIGNATURE = _signatures()

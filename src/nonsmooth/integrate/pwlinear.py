@@ -76,13 +76,15 @@ def mode_coeffs(k, c, b, F0, om, theta, out):
     """Fill ``out`` (length N_MC) for X'' + c X' + k X = F0 cos(om t) + b.
 
     ``theta``: longest piece = theta / max(sqrt(k), om) (radians of the fastest oscillation).
-    Returns False for an undamped mode forced exactly at resonance (no bounded particular
+    Returns False for an undamped mode forced (F0 != 0) exactly at resonance (no bounded particular
     solution; the exact kernels return a status for it).
     """
     d = k - om * om
     den = d * d + (c * om) ** 2
     if not den > 1e-300:
-        return False
+        if F0 != 0.0:
+            return False
+        den = 1.0  # unforced: no particular harmonic part, nothing resonates
     out[MC_K] = k
     out[MC_C] = c
     out[MC_B] = b

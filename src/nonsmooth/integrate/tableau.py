@@ -1,5 +1,5 @@
 """Butcher tableaus. A Runge-Kutta method is only its coefficient table; the stepping and the
-step-size control that use it are written once (``rkf45.py``)."""
+step-size control that use it are written once (``rkstep.py``, ``hybrid.py``)."""
 
 import numpy as np
 

@@ -1,5 +1,90 @@
-"""Models: vector fields, switching surfaces and regions as compiled scalar functions."""
+"""Models: non-smooth forced systems as data plus small compiled functions.
+
+``nonsmooth.models()`` lists the built-in models, ``nonsmooth.model(name)`` returns one (a
+:class:`~nonsmooth.models.base.Model`), ``model.params(**values)`` validates its parameters.
+A user model is a :class:`Model` built in a Python script; ``model("path/to/file.py:NAME")``
+loads it (``NAME`` defaults to ``MODEL``). The contract a model implements is in
+:mod:`nonsmooth.models.base`; one module per built-in model: ``support`` (the paper's
+oscillator with a spring-damper support across a gap), ``two_sided``, ``impact``,
+``stick_slip``.
+"""
+
+from __future__ import annotations
+
+import importlib
+import importlib.util
+import os
+import sys
+import types
 
 from .._numba_cache import configure as _configure_cache
 
 _configure_cache()  # before any compiled module of this package is imported
+
+from ..errors import ParameterError  # noqa: E402
+from .base import BUILTIN, Method, Model, ModelParams, Param, param_index  # noqa: E402
+
+__all__ = ["Model", "Method", "Param", "ModelParams", "param_index", "model", "models",
+           "BUILTIN"]
+
+_USER: dict = {}
+
+
+def models() -> tuple:
+    """Names of the built-in models."""
+    return tuple(BUILTIN)
+
+
+def model(name) -> Model:
+    """The model called ``name`` (built-in), or ``"path/to/file.py:NAME"`` (a ``Model`` named
+    ``NAME``, default ``MODEL``, defined in a user's script), or a ``Model`` itself."""
+    if isinstance(name, Model):
+        return name
+    if not isinstance(name, str) or not name:
+        raise ParameterError(f"model: expected a model name, got {name!r}")
+    if name in BUILTIN:
+        return importlib.import_module(BUILTIN[name]).MODEL
+    path, _, attr = name.partition(":") if name.count(":") and not _is_drive(name) else (name, "", "")
+    if path.endswith(".py"):
+        return _load_user(path, attr or "MODEL")
+    raise ParameterError(f"model: unknown model {name!r} (built-in: {', '.join(BUILTIN)}; or "
+                         f"path/to/file.py:NAME for your own)")
+
+
+def _is_drive(name: str) -> bool:
+    return len(name) > 1 and name[1] == ":" and name.count(":") == 1
+
+
+def _load_user(path: str, attr: str) -> Model:
+    full = os.path.abspath(path)
+    key = (full, attr)
+    if key in _USER:
+        return _USER[key]
+    if not os.path.isfile(full):
+        raise ParameterError(f"model: no such file {path!r}")
+    modname = "nonsmooth_user_model_" + "".join(ch if ch.isalnum() else "_" for ch in full)
+    spec = importlib.util.spec_from_file_location(modname, full)
+    mod = importlib.util.module_from_spec(spec)
+    sys.modules[modname] = mod
+    try:
+        spec.loader.exec_module(mod)
+    except ParameterError:
+        raise
+    except Exception as exc:
+        raise ParameterError(f"model: {path} failed to load: {type(exc).__name__}: "
+                             f"{str(exc).splitlines()[0] if str(exc) else ''}") from None
+    obj = getattr(mod, attr, None)
+    if not isinstance(obj, Model):
+        raise ParameterError(f"model: {path} defines no Model named {attr!r}")
+    _USER[key] = obj
+    return obj
+
+
+class _CallablePackage(types.ModuleType):
+    """``nonsmooth.models`` is this package and, called, lists the built-in models."""
+
+    def __call__(self):
+        return models()
+
+
+sys.modules[__name__].__class__ = _CallablePackage

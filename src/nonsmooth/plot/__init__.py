@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import importlib
 
-#: Region colours used by every figure (codes of models.switch).
+#: Region colours used by every figure (codes of the support model, models.support.switch).
 REGION_COLORS = ("#1f77b4", "#ff7f0e", "#2ca02c", "#d62728")
 REGION_LABELS = (r"$\Gamma_-$", r"$\Sigma_\alpha$", r"$\Sigma_\beta$", r"$\Gamma_+$")
 

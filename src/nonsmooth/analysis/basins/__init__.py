@@ -57,8 +57,8 @@ Algorithm
    circle of radius r_j around a_i, sampled by ``_N_CIRCLE`` points, is mapped by f^(m p)
    (f = the stroboscopic map, m <= ``_M_MAX`` the first multiple that works) inside the disc
    of radius c r_j around a_i, with a margin of half the largest gap between neighbouring
-   image points. The stroboscopic map is a homeomorphism of the plane (``MAP_IS_HOMEOMORPHISM``;
-   without it no certificate is used), so the image of a disc
+   image points. The stroboscopic map is a homeomorphism of the plane (the model's
+   ``flow_is_homeomorphism``; without it no certificate is used), so the image of a disc
    is the inside of the image of its circle: B(a_i, r_j) is mapped into B(a_i, r_{j+1}), and by
    induction every point of B(a_i, r) ends within r_end of a_i (where the linearization rules)
    -- the disc lies in the attractor's basin, and it cannot contain another attractor. A
@@ -112,7 +112,7 @@ import xarray as xr
 from ...errors import ParameterError
 from ...integrate.contract import N_STATE
 from ...io import check_memory, flag_attrs, provenance_attrs, status_flags
-from ...kernels import Solver, advance, new_state, output_buffers
+from ...kernels import Solver, new_state, output_buffers, run
 from ...params import Params
 from ...simulate import check_float, check_int, check_params
 from ...sweep import resolve_workers, threads
@@ -127,10 +127,11 @@ from .order import _coarse_to_fine_order, _Pace, _round_sizes
 __all__ = ["basins", "MAP_IS_HOMEOMORPHISM", "N_CONFIRM", "MATCH_FACTOR", "LABEL_UNDECIDED",
            "KIND_NAMES"]
 
-#: The capture discs and lattice cells (the early stop) are certificates only because the
+#: The capture discs and lattice cells (the early stop) are certificates only where the
 #: stroboscopic map is a homeomorphism of the plane (the image of a disc is the inside of the
-#: image of its circle). A property of the model: it moves to the model interface; where it
-#: is False, no certificate is used and every point runs until it is decided.
+#: image of its circle). Each model method declares it (``Method.flow_is_homeomorphism``:
+#: false for sticking, where trajectories merge); this switch turns certificates off for
+#: every model. Where either is False every point runs until it is decided.
 MAP_IS_HOMEOMORPHISM = True
 
 _CHAOS_ORBIT_PERIODS = 16  # forcing periods of a chaotic attractor's sampled orbit
@@ -175,7 +176,8 @@ def basins(params: Params, *, x=(-3.0, 3.0), v=(-3.0, 3.0), grid=400, method: st
     max_periods = check_int("max_periods", max_periods, 1)
     max_period = check_int("max_period", max_period, 1)
     spp = check_int("samples_per_period", samples_per_period, 2)
-    solver = Solver(method=method, rtol=rtol, atol=atol, transition=transition)
+    solver = Solver(method=method, rtol=rtol, atol=atol, transition=transition,
+                    model=params.model)
     nw = resolve_workers(workers)
     n = nx * nv
     check_memory(n * _BYTES_PER_POINT, "grid",
@@ -192,7 +194,7 @@ def basins(params: Params, *, x=(-3.0, 3.0), v=(-3.0, 3.0), grid=400, method: st
     found = _Attractors(tol)
     clouds = _Clouds(x_lo, x_hi, v_lo, v_hi, n)
     cert = {"periods": 0}
-    certified = bool(early_stop) and MAP_IS_HOMEOMORPHISM
+    certified = bool(early_stop) and MAP_IS_HOMEOMORPHISM and solver.spec.flow_is_homeomorphism
     lat = _Lattice(x_lo, x_hi, v_lo, v_hi, nx, nv, first)
     pace = _Pace(2 * first)
     label = np.full(n, LABEL_UNDECIDED, np.int64)  # in processing order
@@ -229,7 +231,8 @@ def basins(params: Params, *, x=(-3.0, 3.0), v=(-3.0, 3.0), grid=400, method: st
         grid[name][order] = arr
     n_att = len(found.points)
     kind = np.array(found.kind, dtype=np.int64)
-    contact = np.array([int(mx >= 1.0) for mx in found.max_x], dtype=np.int64)
+    contact = np.array([int(params.model.is_contact(params, mk, mx, mn)) for mx, mn, mk in
+                        zip(found.max_x, found.min_x, found.mask)], dtype=np.int64)
     periods = np.array([len(pt) if kd == KIND_PERIODIC else 0
                         for pt, kd in zip(found.points, found.kind)], dtype=np.int64)
     max_x = np.array(found.max_x, dtype=np.float64)
@@ -288,7 +291,7 @@ def _run_round_points(solver, pk, X0, V0, done_before, n, max_periods, transient
 
             def call():
                 before = int(recs[active, _K].sum())
-                _run_round(solver.code, pk, opts, X0, V0, active, max_periods, transient, tol,
+                _run_round(solver.code, solver.fns, pk, opts, X0, V0, active, max_periods, transient, tol,
                            max_period, certified, apts, arad2, alab, lat.cells, lat.geo,
                            budget, states, bufs, recs, cX, cV, cxm, ofs, oi8, ou8)
                 return int(recs[active, _K].sum()) - before
@@ -356,7 +359,7 @@ def _sample_orbits(found, solver, pk, spp):
     for pts, kind in zip(found.points, found.kind):
         nout = (len(pts) if kind == KIND_PERIODIC else _CHAOS_ORBIT_PERIODS) * spp
         X, V, R, M, XM, Xm = output_buffers(nout)
-        if advance(solver.code, pk, solver.opts(), new_state(pts[0, 0], pts[0, 1]), spp, 0, nout,
+        if run(solver.code, solver.fns, pk, solver.opts(), new_state(pts[0, 0], pts[0, 1]), spp, 0, nout,
                    X, V, R, M, XM, Xm) != 0:
             X[:] = np.nan
             V[:] = np.nan

@@ -7,7 +7,7 @@ from __future__ import annotations
 import numpy as np
 
 from ...integrate.contract import ST_X
-from ...kernels import advance, new_state, output_buffers
+from ...kernels import new_state, output_buffers, run
 from ..periodicity import detect_period
 from ._core import N_CONFIRM
 
@@ -46,6 +46,8 @@ class _Attractors:
         self.match_tol = MATCH_FACTOR * tol
         self.points = []   # (q, 2) arrays
         self.max_x = []
+        self.min_x = []
+        self.mask = []  # modes visited on the attractor
         self.radius = []   # (q,) capture radii
         self.certified = []
         self.kind = []
@@ -71,9 +73,13 @@ class _Attractors:
     def was_rejected(self, pts):
         return any(_same_orbit(pts, a, self.match_tol) for a in self.rejected)
 
-    def add(self, pts, xmax, kind=KIND_PERIODIC):
+    def add(self, pts, extremes, kind=KIND_PERIODIC):
+        """A new attractor with section points ``pts`` and ``extremes`` = (max X, min X,
+        visited-mode mask) over the periods followed; returns its label."""
         self.points.append(np.array(pts, dtype=np.float64))
-        self.max_x.append(float(xmax))
+        self.max_x.append(float(extremes[0]))
+        self.min_x.append(float(extremes[1]))
+        self.mask.append(int(extremes[2]))
         self.radius.append(np.zeros(len(pts)))
         self.certified.append(kind != KIND_PERIODIC)
         self.kind.append(kind)
@@ -164,7 +170,7 @@ def _polish(solver, pk, pts, tol):
     q before them within tol) and stays on its points within tol for a further window of at
     least _CONFIRM_MIN periods (and _CONFIRM_MULT of its periods): a chaotic trajectory that
     shadowed an unstable periodic orbit long enough to pass the test drifts away. Returns
-    (points, max X)."""
+    (points, (max X, min X, visited-mode mask))."""
     q = len(pts)
     state = new_state(pts[-1, 0], pts[-1, 1])
     X, V, R, M, XM, Xm = output_buffers(q)
@@ -172,7 +178,7 @@ def _polish(solver, pk, pts, tol):
     last = pts[-1].copy()
     for it in range(max(1, _POLISH_MAX // q)):
         prev = np.stack([X, V], axis=1) if it else pts
-        if advance(solver.code, pk, opts, state, 1, 0, q, X, V, R, M, XM, Xm) != 0:
+        if run(solver.code, solver.fns, pk, opts, state, 1, 0, q, X, V, R, M, XM, Xm) != 0:
             return None
         if not (np.isfinite(X).all() and np.isfinite(V).all()):
             return None
@@ -184,35 +190,40 @@ def _polish(solver, pk, pts, tol):
         return None
     d = next((d for d in range(1, q) if q % d == 0 and (np.abs(X[d:] - X[:-d]) <= tol).all()
               and (np.abs(V[d:] - V[:-d]) <= tol).all()), q)
-    out = np.stack([X[:d], V[:d]], axis=1), float(XM[:d].max())
+    out = np.stack([X[:d], V[:d]], axis=1), _extremes(XM[:d], Xm[:d], M[:d])
     W = X.copy(), V.copy()
     for _ in range(max(_CONFIRM_MULT, -(-_CONFIRM_MIN // q))):
-        if advance(solver.code, pk, opts, state, 1, 0, q, X, V, R, M, XM, Xm) != 0:
+        if run(solver.code, solver.fns, pk, opts, state, 1, 0, q, X, V, R, M, XM, Xm) != 0:
             return None
         if not ((np.abs(X - W[0]) <= tol).all() and (np.abs(V - W[1]) <= tol).all()):
             return None
     return out
 
 
+def _extremes(XM, Xm, M):
+    """(max X, min X, visited-mode mask) of recorded intervals."""
+    return float(XM.max()), float(Xm.min()), int(np.bitwise_or.reduce(M))
+
+
 def _confirm_chaos(solver, pk, state, tol, max_period, scale):
     """A group of undecided trajectories is a chaotic attractor if its first member, followed
     _CHAOS_PERIODS more periods, stays aperiodic (no period <= max_period over its last
     section points) and shows sensitive dependence: a twin started _TWIN * scale away in X
-    separates by _TWIN_GROWTH times that. Returns (_CLOUD section points, max X over the
+    separates by _TWIN_GROWTH times that. Returns (_CLOUD section points, (max X, min X, mode mask) over the
     periods followed) or None."""
     runs = []
     for dx in (0.0, _TWIN * scale):
         s = state.copy()
         s[ST_X] += dx
         X, V, R, M, XM, Xm = output_buffers(_CHAOS_PERIODS)
-        if advance(solver.code, pk, solver.opts(), s, 1, 0, _CHAOS_PERIODS, X, V, R, M, XM,
+        if run(solver.code, solver.fns, pk, solver.opts(), s, 1, 0, _CHAOS_PERIODS, X, V, R, M, XM,
                    Xm) != 0 or not (np.isfinite(X).all() and np.isfinite(V).all()):
             return None
-        runs.append((X, V, XM))
-    (X, V, XM), (X2, V2, _) = runs
+        runs.append((X, V, XM, Xm, M))
+    (X, V, XM, Xm, M), (X2, V2, *_) = runs
     w = 2 * max_period + max(max_period, N_CONFIRM)
     if detect_period(X[-w:], V[-w:], tol, max_period) > 0:
         return None
     if not np.hypot(X - X2, V - V2).max() >= _TWIN_GROWTH * _TWIN * scale:
         return None
-    return np.stack([X[:_CLOUD], V[:_CLOUD]], axis=1), float(XM.max())
+    return np.stack([X[:_CLOUD], V[:_CLOUD]], axis=1), _extremes(XM, Xm, M)

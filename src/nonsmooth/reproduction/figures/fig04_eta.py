@@ -22,7 +22,7 @@ def excursions(ds):
     each starts, whether it enters Gamma+). An excursion is a maximal time span outside Gamma-;
     the sample intervals' visited masks see the thinnest band crossing (two excursions inside
     one sample interval count as one)."""
-    from ...models.switch import GAMMA_MINUS, GAMMA_PLUS
+    from ...models.support.switch import GAMMA_MINUS, GAMMA_PLUS
     R = ds["region"].values
     M = ds["visited"].values.astype(np.int64)
     out = (M[1:] & ~(1 << GAMMA_MINUS)) != 0

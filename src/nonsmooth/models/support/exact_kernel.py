@@ -1,4 +1,4 @@
-"""Exact event-driven solver of the non-smooth system (eta = 0; paper eqs. 4, 7-9).
+"""The support model's specialised exact kernel: event-driven, eta = 0 (paper eqs. 4, 7-9).
 
 Implements the kernel contract of :mod:`nonsmooth.integrate.contract` with the closed-form
 modes and the rigorous event location of :mod:`nonsmooth.integrate.pwlinear`.
@@ -78,10 +78,9 @@ import math
 import numba as nb
 import numpy as np
 
-from .. import status as st
-from ..models.switch import beta_ratio
-from .contract import KERNEL_SIGNATURE, OPT_MAX_STEPS, ST_MODE, ST_V, ST_X
-from .pwlinear import (
+from ... import status as st
+from ...integrate.contract import KERNEL_SIGNATURE, OPT_MAX_STEPS, ST_MODE, ST_V, ST_X
+from ...integrate.pwlinear import (
     CROSSING,
     MC_C,
     MC_K,
@@ -101,7 +100,8 @@ from .pwlinear import (
     propagator_table,
     refine_root,
 )
-from .record import record_interval, store_state
+from ...integrate.record import record_interval, store_state
+from .switch import beta_ratio
 
 FREE = 0  # mode code of free flight (Gamma-)
 CONTACT = 3  # mode code of contact (Gamma+)

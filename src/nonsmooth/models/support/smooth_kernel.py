@@ -1,4 +1,4 @@
-"""Compiled adaptive Runge-Kutta-Fehlberg 4(5) kernel for the smoothed switch model.
+"""The support model's specialised smoothed kernel: adaptive RKF45 for the switch model.
 
 Implements the kernel contract of :mod:`nonsmooth.integrate.contract` for eqs. 10-14.
 
@@ -11,7 +11,7 @@ Design choices
 * **Switches are located, not smeared.** Each step is taken with the vector field of the
   current region held fixed (the region formulas are polynomials, so they extend smoothly past
   their borders). After a step, the exit function of that region (min/max of the indicator
-  functions of eq. 14, ``models.switch.inside_margin``) is checked at the step end and at the
+  functions of eq. 14, ``switch.inside_margin``) is checked at the step end and at the
   interior extrema of h_alpha, h_beta and V on the cubic Hermite interpolant of the step
   (this catches a tangential touch of a band inside one step). If the trajectory left the
   region, the crossing is found on the interpolant (Illinois method, ~1e-12 of the step) and
@@ -33,16 +33,8 @@ import math
 import numba as nb
 import numpy as np
 
-from .. import status as st
-from ..models.switch import (
-    GAMMA_MINUS,
-    SIGMA_ALPHA,
-    accel,
-    beta_ratio,
-    inside_margin,
-    region,
-)
-from .contract import (
+from ... import status as st
+from ...integrate.contract import (
     KERNEL_SIGNATURE,
     OPT_ATOL,
     OPT_MAX_STEPS,
@@ -54,63 +46,32 @@ from .contract import (
     ST_VA,
     ST_X,
 )
-from .record import record_interval, store_state
-from .tableau import RKF45_A, RKF45_B5, RKF45_C, RKF45_E, RKF45_ORDER
-from .roots import quad_roots01
-from .trig import cos_sin_small
-
-_A = RKF45_A
-_B = RKF45_B5
-_E = RKF45_E
-_C = RKF45_C
-_NS = _C.shape[0]
-
-_EXPO = 1.0 / (RKF45_ORDER + 1)  # elementary controller h_new = 0.9 h err^(-1/5)
-_SAFETY = 0.9
-_FM = {"contract", "reassoc"}  # let LLVM fuse and reassociate; NaN/inf semantics are kept
-_FAC_MIN = 0.2
-_FAC_MAX = 5.0
-
-# log2(m) on [0.5, 1), least-squares quartic (error 2e-4)
-_L4, _L3, _L2, _L1, _L0 = (-1.2665305831374971, 5.030988942552058, -8.324856642808804,
-                           8.057095881755412, -3.496846056818563)
-
-
-@nb.njit(cache=True, inline="always")
-def pow_fast(x, a):
-    """x**a for x > 0 to ~2e-4 relative: step-size factors need a smooth estimate, not libm's
-    log and exp on the critical path of every step."""
-    m, e = math.frexp(x)
-    z = a * (e + (((_L4 * m + _L3) * m + _L2) * m + _L1) * m + _L0) * 0.6931471805599453
-    k = math.floor(z * 1.4426950408889634 + 0.5)
-    f = z - k * 0.6931471805599453
-    ef = 1.0 + f * (1.0 + f * (0.5 + f * (1.0 / 6.0 + f * (1.0 / 24.0 + f * (1.0 / 120.0 + f * (
-        1.0 / 720.0))))))
-    return math.ldexp(ef, int(k))
-
-
-@nb.njit(cache=True, inline="always")
-def _cubic(a0, a1, a2, a3, s):
-    return a0 + s * (a1 + s * (a2 + s * a3))
-
-
-@nb.njit(cache=True, inline="always")
-def _x_extrema(X, V, X1, V1, h, xmax, xmin):
-    """(xmax, xmin) updated with the interior extrema of X on the step's cubic Hermite
-    interpolant (where V changes sign)."""
-    if V * V1 < 0.0:
-        dX = X1 - X
-        a1 = h * V
-        a2 = 3.0 * dX - 2.0 * h * V - h * V1
-        a3 = -2.0 * dX + h * V + h * V1
-        q1, q2 = quad_roots01(a1, 2.0 * a2, 3.0 * a3)
-        for q in (q1, q2):
-            if q > 0.0:
-                xq = _cubic(X, a1, a2, a3, q)
-                xmax = max(xmax, xq)
-                xmin = min(xmin, xq)
-    return xmax, xmin
-
+from ...integrate.record import record_interval, store_state
+from ...integrate.rkstep import (
+    _A,
+    _B,
+    _C,
+    _E,
+    _EXPO,
+    _FAC_MAX,
+    _FAC_MIN,
+    _FM,
+    _SAFETY,
+    RKF45_ORDER,
+    _cubic,
+    _x_extrema,
+    pow_fast,
+)
+from ...integrate.roots import quad_roots01
+from ...integrate.trig import cos_sin_small
+from .switch import (
+    GAMMA_MINUS,
+    SIGMA_ALPHA,
+    accel,
+    beta_ratio,
+    inside_margin,
+    region,
+)
 
 @nb.njit(cache=True, inline="always", fastmath=_FM)
 def _rk_step(mode, X0, V0, A0, Va, C, S, h, om, F0, w02, ws2, xi, xis, eta, r, tr):

@@ -1,0 +1,528 @@
+"""Generic compiled kernel for hybrid (piecewise-smooth, event-driven) forced oscillators.
+
+Implements the kernel contract of :mod:`nonsmooth.integrate.contract` for any model given as
+the tuple of compiled functions ``fns = (field, jacobian, guards, transition, initial, linear)``
+(signatures ``contract.MODEL_SIGNATURES``); nothing here knows a particular model.
+
+Design summary
+--------------
+* A mode's field is integrated with the RKF45 table of :mod:`.tableau` (local extrapolation,
+  elementary controller h err^(-1/5) with ``pow_fast``, RMS error norm over the n components,
+  output times hit by shortening the last step without disturbing the controller), as in
+  :mod:`.rkf45`; each step holds the field of the current mode fixed.
+* Guards are affine in (u, cos, sin): inside a mode every g_k >= 0. After an accepted step the
+  exit test is g_k(end) < 0, or a negative value of g_k (on the step's cubic Hermite state
+  interpolant, exact forcing) at an interior minimum of the Hermite of (g, g'). The earliest
+  exit over all guards is located by the Illinois method to 1e-13 of the step, the step is
+  retaken exactly up to it, and ``transition`` (reset, new mode) is applied there; no FSAL
+  across a switch. A guard with g <= 0 and g' < 0 at a step start triggers its transition at
+  once; more than ``ZENO_MAX`` consecutive transitions each < ``ZENO_DT`` T apart -> ZENO.
+* ``opts[OPT_CLOSED_FORM] == 1`` and n == 2: modes that ``linear`` declares
+  X'' + c X' + k X = F cos(omega t) + b (k > 0) are propagated in closed form
+  (:mod:`.pwlinear`) in pieces of at most THETA = 0.7 rad of their fastest oscillation; the
+  same exit test is applied to the exact piece ends, the crossing is located by Illinois on the
+  exact closed-form state, and interior extrema of X are refined by Newton on V = 0 (exact).
+* The local time restarts at 0 at each forcing period and the step state (u, mode, h, mem) is
+  all that carries over, so results are split-invariant bit for bit.
+
+Status codes: OK, MAX_STEPS, STEP_TOO_SMALL, NON_FINITE (also for a non-finite input, a
+non-positive omega, or an opts layout that does not fit ``state``), ZENO, EVENT_FAILED (a
+transition or ``initial`` returned a mode outside 0..7), RESONANCE (a closed-form mode forced
+exactly at its undamped resonance).
+"""
+
+from __future__ import annotations
+
+import math
+import warnings
+
+import numba as nb
+import numpy as np
+
+# passing compiled model functions uses numba's (experimental) first-class function types
+warnings.filterwarnings("ignore", category=nb.NumbaExperimentalFeatureWarning)
+
+from .. import status as st  # noqa: E402
+from .contract import (  # noqa: E402
+    GENERIC_KERNEL_SIGNATURE,
+    MAX_GUARDS,
+    N_STATE,
+    OPT_ATOL,
+    OPT_CLOSED_FORM,
+    OPT_MAX_STEPS,
+    OPT_N,
+    OPT_NMEM,
+    OPT_OMEGA,
+    OPT_RTOL,
+    ST_EXTRA,
+    ST_H,
+    ST_MODE,
+    ST_V,
+    ST_VA,
+    ST_X,
+)
+from .pwlinear import MC_LMAX, N_MC, accel, eval_state, hom_part, mode_coeffs  # noqa: E402
+from .record import record_interval  # noqa: E402
+from .roots import quad_roots01  # noqa: E402
+from .rkstep import _A, _B, _C, _E, _EXPO, _FAC_MAX, _FAC_MIN, _FM, _SAFETY, _cubic, _x_extrema  # noqa: E402
+from .rkstep import pow_fast as _pow_fast  # noqa: E402
+from .trig import cos_sin_small  # noqa: E402
+
+MAX_MODES = 8  # mode codes 0..7 (bit mask M is uint8)
+THETA = 0.7  # longest closed-form piece, radians of the fastest oscillation of the mode
+ZENO_MAX = 64
+ZENO_DT = 1e-9
+S_TOL = 1e-13  # event location tolerance, fraction of the step
+
+# mode classes for the closed-form table
+_MC_UNKNOWN = 0
+_MC_CLOSED = 1
+_MC_RK = 2
+_MC_RESONANT = 3
+
+# log2(m) on [0.5, 1), least-squares quartic (same as rkf45.pow_fast)
+@nb.njit(cache=True, inline="always")
+def _gval(G, k, n, u, C, S):
+    """Guard k at state u and forcing phase (C, S)."""
+    g = G[k, n] + G[k, n + 1] * C + G[k, n + 2] * S
+    for i in range(n):
+        g += G[k, i] * u[i]
+    return g
+
+
+@nb.njit(cache=True, inline="always")
+def _dgval(G, k, n, du, C, S, om):
+    """Time derivative of guard k along the flow du."""
+    d = om * (G[k, n + 2] * C - G[k, n + 1] * S)
+    for i in range(n):
+        d += G[k, i] * du[i]
+    return d
+
+
+@nb.njit(cache=True, fastmath=_FM)
+def _rk_step(field, mode, tau, C, S, h, om, n, u, k0, pp, mem, rtol, atol, us, k1, k2, k3, k4,
+             k5, u1):
+    """One RKF45 step of length h from (tau, u) with field(mode) fixed; k0 = field at the start.
+    Writes the 5th-order solution to u1; returns (squared RMS error norm, cos, sin at the end).
+    The error norm is NaN when u1 is not finite."""
+    c1, s1 = cos_sin_small(om * 0.125 * h)
+    c2 = c1 * c1 - s1 * s1
+    s2 = 2.0 * c1 * s1
+    c3 = c2 * c1 - s2 * s1
+    s3 = s2 * c1 + c2 * s1
+    c4 = c2 * c2 - s2 * s2
+    s4 = 2.0 * c2 * s2
+    c8 = c4 * c4 - s4 * s4
+    s8 = 2.0 * c4 * s4
+    c12, s12 = cos_sin_small(om * _C[3] * h)
+    C1 = C * c8 - S * s8
+    S1 = S * c8 + C * s8
+    for i in range(n):
+        us[i] = u[i] + h * (_A[1, 0] * k0[i])
+    field(mode, tau + _C[1] * h, C * c2 - S * s2, S * c2 + C * s2, us, pp, mem, k1)
+    for i in range(n):
+        us[i] = u[i] + h * (_A[2, 0] * k0[i] + _A[2, 1] * k1[i])
+    field(mode, tau + _C[2] * h, C * c3 - S * s3, S * c3 + C * s3, us, pp, mem, k2)
+    for i in range(n):
+        us[i] = u[i] + h * (_A[3, 0] * k0[i] + _A[3, 1] * k1[i] + _A[3, 2] * k2[i])
+    field(mode, tau + _C[3] * h, C * c12 - S * s12, S * c12 + C * s12, us, pp, mem, k3)
+    for i in range(n):
+        us[i] = u[i] + h * (_A[4, 0] * k0[i] + _A[4, 1] * k1[i] + _A[4, 2] * k2[i]
+                            + _A[4, 3] * k3[i])
+    field(mode, tau + h, C1, S1, us, pp, mem, k4)
+    for i in range(n):
+        us[i] = u[i] + h * (_A[5, 0] * k0[i] + _A[5, 1] * k1[i] + _A[5, 2] * k2[i]
+                            + _A[5, 3] * k3[i] + _A[5, 4] * k4[i])
+    field(mode, tau + _C[5] * h, C * c4 - S * s4, S * c4 + C * s4, us, pp, mem, k5)
+    err2 = 0.0
+    finite = True
+    for i in range(n):
+        x1 = u[i] + h * (_B[0] * k0[i] + _B[2] * k2[i] + _B[3] * k3[i] + _B[4] * k4[i]
+                         + _B[5] * k5[i])
+        e = h * (_E[0] * k0[i] + _E[2] * k2[i] + _E[3] * k3[i] + _E[4] * k4[i] + _E[5] * k5[i])
+        u1[i] = x1
+        sc = atol + rtol * max(abs(u[i]), abs(x1))
+        err2 += (e / sc) ** 2
+        if not math.isfinite(x1):
+            finite = False
+    err2 = err2 / n
+    if not finite:
+        err2 = np.nan  # an overflow makes sc infinite and err2 zero: never accept it
+    return err2, C1, S1
+
+
+@nb.njit(cache=True)
+def _x_extrema_exact(MC, m, om, y0, z0, C, S, X, V, X1, V1, h, xmax, xmin):
+    """Interior extrema of X on a closed-form piece of length h: first guesses from the cubic
+    Hermite of X, then Newton on V(s) = 0 with the exact state (V' = X'')."""
+    dX = X1 - X
+    a1 = h * V
+    a2 = 3.0 * dX - 2.0 * h * V - h * V1
+    a3 = -2.0 * dX + h * V + h * V1
+    q1, q2 = quad_roots01(a1, 2.0 * a2, 3.0 * a3)
+    for q in (q1, q2):
+        if q > 0.0:
+            s = q * h
+            Xs = 0.0
+            for _ in range(6):
+                Xs, Vs, As, ys, zs, Cs, Ss = eval_state(MC, m, om, y0, z0, C, S, s)
+                if As == 0.0:
+                    break
+                ds = -Vs / As
+                sn = min(h, max(0.0, s + ds))
+                if abs(sn - s) <= 1e-15 * h:
+                    break
+                s = sn
+            # any value taken on the piece is a valid bound candidate, converged or not
+            xmax = max(xmax, Xs)
+            xmin = min(xmin, Xs)
+    return xmax, xmin
+
+
+@nb.njit(cache=True, fastmath=_FM)
+def _g_at(cf, s, G, k, n, q0, q1, q2, q3, C, S, om, hs, MC, mode, y0, z0):
+    """Guard k at the fraction s of the current step: on the exact closed form (cf) or on the
+    cubic Hermite of the state (projection coefficients q0..q3), with the exact forcing."""
+    if cf:
+        X, V, A, y, z, Cs, Ss = eval_state(MC, mode, om, y0, z0, C, S, s * hs)
+        return G[k, 0] * X + G[k, 1] * V + G[k, 2] + G[k, 3] * Cs + G[k, 4] * Ss
+    cw, sw = cos_sin_small(om * s * hs)
+    Cs = C * cw - S * sw
+    Ss = S * cw + C * sw
+    return _cubic(q0, q1, q2, q3, s) + G[k, n] + G[k, n + 1] * Cs + G[k, n + 2] * Ss
+
+
+@nb.njit(cache=True)
+def _mode_class(linear, closed, mode, pp, lin, MC, mcs, om):
+    """_MC_CLOSED / _MC_RK / _MC_RESONANT for ``mode``, filling the table row lazily."""
+    if not closed:
+        return _MC_RK
+    if mcs[mode] == _MC_UNKNOWN:
+        mcs[mode] = _MC_RK
+        if linear(mode, pp, lin) == 1 and lin[0] > 0.0:
+            if mode_coeffs(lin[0], lin[1], lin[2], lin[3], om, THETA, MC[mode]):
+                mcs[mode] = _MC_CLOSED
+            else:
+                mcs[mode] = _MC_RESONANT
+    return mcs[mode]
+
+
+@nb.njit(cache=True, inline="always")
+def _deriv(cf, field, mode, tau, C, S, u, pp, mem, f, MC, om):
+    """f = du/dt in ``mode`` at (tau, u); from the closed form for a closed-form mode."""
+    if cf:
+        y, z = hom_part(MC, mode, om, u[0], u[1], C, S)
+        f[0] = u[1]
+        f[1] = accel(MC, mode, om, y, z, C, S)
+    else:
+        field(mode, tau, C, S, u, pp, mem, f)
+
+
+@nb.njit(cache=True, inline="always")
+def _store(state, u, n, mem, nmem, mode, h):
+    state[ST_X] = u[0]
+    state[ST_V] = u[1]
+    state[ST_VA] = u[1]
+    state[ST_MODE] = mode
+    state[ST_H] = h
+    for i in range(2, n):
+        state[ST_EXTRA + i - 2] = u[i]
+    for i in range(nmem):
+        state[ST_EXTRA + n - 2 + i] = mem[i]
+
+
+@nb.njit(GENERIC_KERNEL_SIGNATURE, cache=True, fastmath=_FM)
+def advance_generic(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out, M_out,
+                    Xmax_out, Xmin_out):
+    """Kernel contract (see ``integrate.contract``) for a hybrid model given by ``fns``."""
+    field, jacobian, guards, transition, initial, linear = fns
+    n = int(opts[OPT_N])
+    nmem = int(opts[OPT_NMEM])
+    if n < 2 or nmem < 0 or n - 2 + nmem > N_STATE - ST_EXTRA:
+        return st.NON_FINITE
+    pp = np.empty(len(p))
+    pp[:] = p
+    om = pp[int(opts[OPT_OMEGA])]
+    if not (om > 0.0 and math.isfinite(om)):
+        return st.NON_FINITE
+    rtol = opts[OPT_RTOL]
+    atol = opts[OPT_ATOL]
+    closed = opts[OPT_CLOSED_FORM] == 1.0 and n == 2
+
+    u = np.empty(n)
+    u1 = np.empty(n)
+    f0 = np.empty(n)
+    f1 = np.empty(n)
+    us = np.empty(n)
+    k1 = np.empty(n)
+    k2 = np.empty(n)
+    k3 = np.empty(n)
+    k4 = np.empty(n)
+    k5 = np.empty(n)
+    mem = np.zeros(max(nmem, 1))
+    G = np.zeros((MAX_GUARDS, n + 3))
+    MC = np.zeros((MAX_MODES, N_MC))
+    mcs = np.zeros(MAX_MODES, np.int64)
+    lin = np.zeros(4)
+
+    u[0] = state[ST_X]
+    u[1] = state[ST_V]
+    for i in range(2, n):
+        u[i] = state[ST_EXTRA + i - 2]
+    for i in range(nmem):
+        mem[i] = state[ST_EXTRA + n - 2 + i]
+    mode = int(state[ST_MODE])
+    h = state[ST_H]
+    for i in range(n):
+        if not math.isfinite(u[i]):
+            return st.NON_FINITE
+
+    T = 2.0 * math.pi / om
+    dt = T / per_period
+    if not h > 0.0:
+        h = min(1e-3 * T, dt)
+    hmin = 1e-14 * T
+    zeno_dt = ZENO_DT * T
+    n_total = n_skip + n_out
+    max_steps = int(opts[OPT_MAX_STEPS] * (n_total / per_period + 1.0))
+
+    code = st.OK
+    if mode < 0:
+        mode = initial(1.0, 0.0, u, pp, mem)
+    if mode < 0 or mode >= MAX_MODES:
+        _store(state, u, n, mem, nmem, mode, h)
+        return st.EVENT_FAILED
+    ng = min(max(guards(mode, pp, mem, G), 0), MAX_GUARDS)
+    cls = _mode_class(linear, closed, mode, pp, lin, MC, mcs, om)
+    if cls == _MC_RESONANT:
+        _store(state, u, n, mem, nmem, mode, h)
+        return st.RESONANCE
+    cf = cls == _MC_CLOSED
+
+    tau = 0.0
+    C = 1.0
+    S = 0.0
+    _deriv(cf, field, mode, tau, C, S, u, pp, mem, f0, MC, om)
+    steps = 0
+    rejected = False
+    n_tiny = 0
+    t_switch = -1e300
+    j = 0
+    for it in range(n_total):
+        j += 1
+        t_end = T if j == per_period else j * dt
+        xmax = u[0]
+        xmin = u[0]
+        mask = 1 << mode
+        while tau < t_end:
+            # ---- immediate exit at the step start: g <= 0 and moving out ----
+            k_tr = -1
+            for k in range(ng):
+                if _gval(G, k, n, u, C, S) <= 0.0 and _dgval(G, k, n, f0, C, S, om) < 0.0:
+                    k_tr = k
+                    break
+            if k_tr < 0:
+                if steps >= max_steps:
+                    code = st.MAX_STEPS
+                    break
+                steps += 1
+                rem = t_end - tau
+                y0 = 0.0
+                z0 = 0.0
+                err2 = 0.0
+                if cf:
+                    Lm = MC[mode, MC_LMAX]
+                    last = Lm >= rem
+                    hs = rem if last else Lm
+                    y0, z0 = hom_part(MC, mode, om, u[0], u[1], C, S)
+                    X1, V1, A1, y1, z1, C1, S1 = eval_state(MC, mode, om, y0, z0, C, S, hs)
+                    if not (math.isfinite(X1) and math.isfinite(V1)):
+                        code = st.NON_FINITE
+                        break
+                    u1[0] = X1
+                    u1[1] = V1
+                    f1[0] = V1
+                    f1[1] = A1
+                else:
+                    last = h >= rem * 0.999
+                    hs = rem if last else h
+                    err2, C1, S1 = _rk_step(field, mode, tau, C, S, hs, om, n, u, f0, pp, mem,
+                                            rtol, atol, us, k1, k2, k3, k4, k5, u1)
+                    if not err2 <= 1.0:
+                        finite = math.isfinite(err2)
+                        fac = (max(_FAC_MIN, _SAFETY * _pow_fast(err2, -0.5 * _EXPO))
+                               if finite else _FAC_MIN)
+                        h = hs * fac
+                        rejected = True
+                        if h < hmin:
+                            code = st.STEP_TOO_SMALL if finite else st.NON_FINITE
+                            break
+                        continue
+                    field(mode, tau + hs, C1, S1, u1, pp, mem, f1)
+
+                # ---- exit test for every guard; earliest crossing located by Illinois ----
+                s_best = 2.0
+                for k in range(ng):
+                    g0 = _gval(G, k, n, u, C, S)
+                    d0 = _dgval(G, k, n, f0, C, S, om)
+                    if g0 < 0.0:
+                        g0 = 0.0  # round-off after the switch into this mode (d0 >= 0 here)
+                    g1 = _gval(G, k, n, u1, C1, S1)
+                    d1 = _dgval(G, k, n, f1, C1, S1, om)
+                    q0 = 0.0
+                    q1 = 0.0
+                    q2 = 0.0
+                    q3 = 0.0
+                    if not cf:  # projection of the state's cubic Hermite on the guard
+                        for i in range(n):
+                            du = u1[i] - u[i]
+                            q0 += G[k, i] * u[i]
+                            q1 += G[k, i] * (hs * f0[i])
+                            q2 += G[k, i] * (3.0 * du - 2.0 * hs * f0[i] - hs * f1[i])
+                            q3 += G[k, i] * (-2.0 * du + hs * f0[i] + hs * f1[i])
+                    hi = 2.0
+                    ghi = 0.0
+                    if g1 < 0.0:
+                        hi = 1.0
+                        ghi = g1
+                    dg = g1 - g0
+                    b1 = hs * d0
+                    b2 = 3.0 * dg - 2.0 * hs * d0 - hs * d1
+                    b3 = -2.0 * dg + hs * d0 + hs * d1
+                    r1, r2 = quad_roots01(b1, 2.0 * b2, 3.0 * b3)
+                    for q in (r1, r2):
+                        if 0.0 < q < hi and 2.0 * b2 + 6.0 * b3 * q > 0.0:  # a minimum
+                            gq = _g_at(cf, q, G, k, n, q0, q1, q2, q3, C, S, om, hs, MC, mode,
+                                       y0, z0)
+                            if gq < 0.0:
+                                hi = q
+                                ghi = gq
+                    if hi > 1.0:
+                        continue
+                    if hi > s_best:
+                        gb = _g_at(cf, s_best, G, k, n, q0, q1, q2, q3, C, S, om, hs, MC, mode,
+                                   y0, z0)
+                        if gb >= 0.0:
+                            continue
+                        hi = s_best
+                        ghi = gb
+                    lo = 0.0
+                    glo = g0
+                    side = 0
+                    for _ in range(200):
+                        if hi - lo <= S_TOL:
+                            break
+                        den = ghi - glo
+                        sm = (lo * ghi - hi * glo) / den if den != 0.0 else 0.5 * (lo + hi)
+                        if not (lo < sm < hi):
+                            sm = 0.5 * (lo + hi)
+                        gm = _g_at(cf, sm, G, k, n, q0, q1, q2, q3, C, S, om, hs, MC, mode,
+                                   y0, z0)
+                        if gm < 0.0:
+                            hi = sm
+                            ghi = gm
+                            if side == -1:
+                                glo *= 0.5
+                            side = -1
+                        else:
+                            lo = sm
+                            glo = gm
+                            if side == 1:
+                                ghi *= 0.5
+                            side = 1
+                    if hi - lo > S_TOL:
+                        code = st.EVENT_FAILED
+                        break
+                    if hi < s_best:
+                        s_best = hi
+                        k_tr = k
+                if code != st.OK:
+                    break
+
+                if k_tr >= 0:
+                    if s_best < 1.0:  # retake the step exactly up to the crossing
+                        hs = s_best * hs
+                        last = False
+                        if cf:
+                            X1, V1, A1, y1, z1, C1, S1 = eval_state(MC, mode, om, y0, z0, C, S,
+                                                                    hs)
+                            u1[0] = X1
+                            u1[1] = V1
+                            f1[0] = V1
+                            f1[1] = A1
+                        else:
+                            err2, C1, S1 = _rk_step(field, mode, tau, C, S, hs, om, n, u, f0,
+                                                    pp, mem, rtol, atol, us, k1, k2, k3, k4, k5,
+                                                    u1)
+                            field(mode, tau + hs, C1, S1, u1, pp, mem, f1)
+                        if not math.isfinite(u1[0]):
+                            code = st.NON_FINITE
+                            break
+                elif not cf:
+                    # step-size control after an accepted step without a switch
+                    fac = _SAFETY * _pow_fast(max(err2, 1e-30), -0.5 * _EXPO)
+                    fac = min(_FAC_MAX, max(_FAC_MIN, fac))
+                    if rejected:
+                        fac = min(fac, 1.0)
+                    h_new = hs * fac
+                    h = max(h, h_new) if last else h_new
+                    rejected = False
+                if cf:
+                    xmax, xmin = _x_extrema_exact(MC, mode, om, y0, z0, C, S, u[0], u[1], u1[0],
+                                                  u1[1], hs, xmax, xmin)
+                else:
+                    xmax, xmin = _x_extrema(u[0], f0[0], u1[0], f1[0], hs, xmax, xmin)
+                for i in range(n):
+                    u[i] = u1[i]
+                    f0[i] = f1[i]
+                C = C1
+                S = S1
+                tau = t_end if last else tau + hs
+                xmax = max(xmax, u[0])
+                xmin = min(xmin, u[0])
+            if k_tr >= 0:
+                # ---- transition through guard k_tr at (tau, u) ----
+                new_mode = transition(mode, k_tr, tau, C, S, u, pp, mem)
+                if tau - t_switch < zeno_dt:
+                    n_tiny += 1
+                    if n_tiny > ZENO_MAX:
+                        code = st.ZENO
+                        break
+                else:
+                    n_tiny = 0
+                t_switch = tau
+                if new_mode < 0 or new_mode >= MAX_MODES:
+                    code = st.EVENT_FAILED
+                    break
+                mode = new_mode
+                mask |= 1 << mode
+                ng = min(max(guards(mode, pp, mem, G), 0), MAX_GUARDS)
+                cls = _mode_class(linear, closed, mode, pp, lin, MC, mcs, om)
+                if cls == _MC_RESONANT:
+                    code = st.RESONANCE
+                    break
+                cf = cls == _MC_CLOSED
+                _deriv(cf, field, mode, tau, C, S, u, pp, mem, f0, MC, om)
+                ok = True
+                for i in range(n):
+                    if not math.isfinite(u[i]):
+                        ok = False
+                if not ok:
+                    code = st.NON_FINITE
+                    break
+                xmax = max(xmax, u[0])
+                xmin = min(xmin, u[0])
+        if code != st.OK:
+            break
+        if j == per_period:
+            j = 0
+            tau = 0.0
+            t_switch -= T
+            C = 1.0
+            S = 0.0
+            rejected = False
+            _deriv(cf, field, mode, tau, C, S, u, pp, mem, f0, MC, om)
+        record_interval(it, n_skip, u[0], u[1], mode, mask, xmax, xmin, X_out, V_out, R_out,
+                        M_out, Xmax_out, Xmin_out)
+    _store(state, u, n, mem, nmem, mode, h)
+    return code

@@ -1,0 +1,487 @@
+"""The model interface: what a non-smooth system declares so that every kernel, analysis, plot
+and CLI command of ``nonsmooth`` runs on it.
+
+A model is plain data plus a few small compiled functions (numba ``cfunc`` s with the fixed
+signatures of :mod:`nonsmooth.integrate.contract`). It declares
+
+* **parameters** (:class:`Param`): names, defaults, allowed ranges, units, long names and a
+  plot symbol; a cross-field ``check`` for constraints between parameters; named ``presets``.
+  Compiled code reads a parameter by an index derived from the names in one place
+  (:func:`param_index`), never by a hard-coded position;
+* the **forcing**: harmonic with frequency ``omega`` (a parameter name); the period
+  T = 2 pi / omega frames time (output intervals, the stroboscopic section at t = kT, and the
+  local time that restarts at 0 every period). Functions receive t and (c, s) = (cos omega t,
+  sin omega t), so they never evaluate a cosine;
+* the **state** u of dimension n >= 2 (``state_names``; u[0] is the displacement X that
+  analyses and plots show, u[1] its rate V), and ``n_memory`` slots of discrete memory ``mem``
+  (e.g. the entry velocity X_dot_a of the paper's eq. 13a) that transitions may write;
+* **modes** (``mode_names``, at most 8): each mode has a smooth vector field and its Jacobian;
+* per **method** (:class:`Method`: ``"smooth"`` for a switch model with band eta, ``"exact"``
+  for the non-smooth system, event-driven), the functions
+
+  ``field(mode, t, c, s, u, p, mem, du) -> 0``
+      du/dt in ``mode`` (write du[0:n]). Fields must extend smoothly past their mode's
+      borders: a step is taken with the field of the current mode held fixed.
+  ``jacobian(mode, t, c, s, u, p, mem, J) -> 0``
+      d field / du (write J[0:n, 0:n]); checked against finite differences at definition.
+  ``guards(mode, p, mem, G) -> n_g``
+      the switching surfaces watched in ``mode``, as affine rows: surface k is
+      g_k = G[k, :n] . u + G[k, n] + G[k, n+1] cos(omega t) + G[k, n+2] sin(omega t), and
+      **every g_k >= 0 inside the mode**; the mode is left through k when g_k turns negative.
+      (Affine in the state and the forcing covers gaps, velocity surfaces and friction
+      limits; ``mem`` may select which surfaces are active.)
+  ``transition(mode, k, t, c, s, u, p, mem) -> new_mode``
+      called at the located crossing of surface k: the new mode; may reset u in place (an
+      impact law) and write mem; may return ``mode`` itself (a reset-only event). Physical
+      chatter must be resolved here (e.g. switch to a sticking mode when the impact velocity
+      is negligible); the kernel reports ``status.ZENO`` for a model that does not.
+  ``initial(c, s, u, p, mem) -> mode``
+      the mode of a state at t = 0 (and its memory).
+  ``linear(mode, p, out) -> 0 or 1`` (optional, n = 2)
+      1 if the mode is X'' + c X' + k X = F cos(omega t) + b with k > 0 (out[0:4] = k, c, b,
+      F): the exact method then propagates it in closed form.
+
+* what analyses and plots need: ``contact(params, mask, max_X, min_X)`` (does an orbit with
+  this visited-mode mask and these extremes of X count as "in contact", named
+  ``contact_name``), ``lines(params, method)`` (values of X to draw, with labels) and, per
+  method, ``flow_is_homeomorphism`` (false where trajectories merge, e.g. in sticking: basins
+  then never use the certified early labelling, which assumes an injective map).
+
+From these, the compiled generic kernel (:mod:`nonsmooth.integrate.hybrid`: RKF45 with located
+switches and resets, closed-form pieces for linear modes) integrates the model, and
+``simulate``, ``poincare``, ``bifurcation_diagram``, ``resonance_curve``, ``basins``,
+``eta_study`` and the CLI work for it. The functions are compiled once (``cfunc``,
+``cache=True``) and cached on disk like the built-in kernels. A built-in model may also name a
+specialised kernel (``Method.kernel``) compiled with its functions inlined.
+"""
+
+from __future__ import annotations
+
+import math
+import warnings
+from dataclasses import dataclass, field as _field
+from typing import Callable
+
+import numpy as np
+
+from ..errors import ParameterError
+
+#: Kernel codes of :func:`nonsmooth.kernels.run`: the generic kernel, and the specialised
+#: kernels of the built-in ``support`` model.
+KERNEL_GENERIC = 2
+KERNEL_SUPPORT_SMOOTH = 0
+KERNEL_SUPPORT_EXACT = 1
+
+MAX_MODES = 8
+
+
+# ---- parameters ------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class Param:
+    """One named parameter: default, allowed interval (``low``/``high``, open or closed ends),
+    units, long name and plot symbol (matplotlib mathtext)."""
+
+    name: str
+    default: float | None = None
+    low: float = -math.inf
+    high: float = math.inf
+    low_open: bool = False
+    high_open: bool = False
+    units: str = "1"
+    long_name: str = ""
+    symbol: str = ""
+
+    @property
+    def range_text(self) -> str:
+        """The allowed range as text, e.g. ``0 < eta < 0.5``."""
+        lo = None if self.low == -math.inf else f"{self.low:g} {'<' if self.low_open else '<='} "
+        hi = None if self.high == math.inf else f" {'<' if self.high_open else '<='} {self.high:g}"
+        if lo is None and hi is None:
+            return "any finite value"
+        return f"{lo or ''}{self.name}{hi or ''}"
+
+    def check(self, value) -> float:
+        """``value`` as a float in range, else a one-line ParameterError naming the field."""
+        if isinstance(value, (bool, np.bool_)):
+            raise ParameterError(f"{self.name}: expected a number, got {value!r}")
+        try:
+            v = float(value)
+        except (TypeError, ValueError):
+            raise ParameterError(f"{self.name}: expected a number, got {value!r}") from None
+        if not math.isfinite(v):
+            raise ParameterError(f"{self.name}: must be finite, got {v!r} "
+                                 f"(allowed: {self.range_text})")
+        bad_lo = v <= self.low if self.low_open else v < self.low
+        bad_hi = v >= self.high if self.high_open else v > self.high
+        if bad_lo or bad_hi:
+            raise ParameterError(f"{self.name}: must satisfy {self.range_text}, got {v:g}")
+        return v
+
+
+def param_index(params) -> dict:
+    """name -> position in the packed parameter array: the one place that fixes the layout."""
+    return {p.name: i for i, p in enumerate(params)}
+
+
+class ParamsBase:
+    """Marker base of every model's validated parameters (``Params`` of the support model,
+    :class:`ModelParams` of the others); ``params.model`` is their model."""
+
+    __slots__ = ()
+
+
+class ModelParams(ParamsBase):
+    """Validated, immutable parameter values of one model (``model.params(**values)``).
+
+    Values are attributes (``p.omega``); ``pack()`` gives the float64 array the kernels read,
+    in the order of ``model.param_names``."""
+
+    __slots__ = ("_model", "_values")
+
+    def __init__(self, model: "Model", **values):
+        object.__setattr__(self, "_model", model)
+        object.__setattr__(self, "_values", model.validate(values))
+
+    # mapping-like access
+    def __getattr__(self, name):
+        try:
+            return self._values[name]
+        except KeyError:
+            raise AttributeError(name) from None
+
+    def __setattr__(self, name, value):
+        raise AttributeError("parameters are immutable; use replace(...)")
+
+    def __eq__(self, other):
+        return (isinstance(other, ModelParams) and other.model is self.model
+                and other.as_dict() == self.as_dict())
+
+    def __hash__(self):
+        return hash((self.model.name, tuple(self.as_dict().items())))
+
+    def __repr__(self):
+        inner = ", ".join(f"{k}={v!r}" for k, v in self.as_dict().items())
+        return f"{self.model.name}.params({inner})"
+
+    @property
+    def model(self) -> "Model":
+        return self._model
+
+    def as_dict(self) -> dict:
+        return dict(self._values)
+
+    def replace(self, **changes) -> "ModelParams":
+        """A copy with some values changed (validated again)."""
+        return self.model.params(**{**self.as_dict(), **changes})
+
+    def pack(self) -> np.ndarray:
+        return np.array([self._values[n] for n in self.model.param_names], dtype=np.float64)
+
+    @property
+    def period(self) -> float:
+        """Forcing period T = 2 pi / omega."""
+        return 2.0 * math.pi / self._values[self.model.omega]
+
+    def attrs(self) -> dict:
+        """Flat netCDF attributes: ``model`` and ``param_<name>``."""
+        return {"model": self.model.name,
+                **{f"param_{k}": float(v) for k, v in self.as_dict().items()}}
+
+
+# ---- methods and models ----------------------------------------------------------------------
+@dataclass(frozen=True)
+class Method:
+    """How one method (``"smooth"`` or ``"exact"``) of a model is integrated.
+
+    ``field``, ``jacobian``, ``guards``, ``transition``, ``initial``, ``linear``: plain Python
+    functions that numba can compile with the signatures of ``integrate.contract`` (see the
+    module docstring). ``closed_form``: propagate the modes ``linear`` declares in closed
+    form. ``modes``: the mode codes this method uses. ``rtol``/``atol``: tolerances it
+    enforces at most (the exact method of a model with nonlinear modes integrates those at a
+    tight tolerance). ``kernel``: a specialised kernel code of a built-in model, else the
+    generic kernel."""
+
+    field: Callable
+    jacobian: Callable
+    guards: Callable
+    transition: Callable
+    initial: Callable
+    linear: Callable | None = None
+    closed_form: bool = False
+    flow_is_homeomorphism: bool = False
+    modes: tuple = ()
+    description: str = ""
+    rtol: float | None = None
+    atol: float | None = None
+    kernel: int = KERNEL_GENERIC
+
+
+def _no_linear(mode, p, out):
+    return 0
+
+
+@dataclass(frozen=True, eq=False)
+class Model:
+    """A non-smooth forced system (see the module docstring for the contract)."""
+
+    name: str
+    description: str
+    parameters: tuple
+    state_names: tuple
+    mode_names: tuple
+    methods: dict
+    omega: str = "omega"
+    forcing_amplitude: str | None = "F0"
+    n_memory: int = 0
+    state_units: tuple = ()
+    state_long_names: tuple = ()
+    references: tuple = ()
+    presets: dict = _field(default_factory=dict)
+    check: Callable | None = None
+    contact_modes: int = 0
+    contact: Callable | None = None
+    contact_name: str = "contact"
+    lines: Callable | None = None
+    params_class: type | None = None
+    source: str = "built-in"
+
+    def __post_init__(self):
+        bad = lambda msg: ParameterError(f"model {self.name}: {msg}")  # noqa: E731
+        names = [p.name for p in self.parameters]
+        if len(set(names)) != len(names):
+            raise bad("parameter names must be unique")
+        if self.omega not in names:
+            raise bad(f"the forcing frequency {self.omega!r} must be a parameter")
+        n = len(self.state_names)
+        if n < 2:
+            raise bad(f"the state needs n >= 2 components (X, V, ...), got {n}")
+        if n - 2 + self.n_memory > 11:
+            raise bad("n - 2 + n_memory must be <= 11")
+        if not 1 <= len(self.mode_names) <= MAX_MODES:
+            raise bad(f"between 1 and {MAX_MODES} modes, got {len(self.mode_names)}")
+        if not self.methods:
+            raise bad("at least one method ('smooth' or 'exact') is needed")
+        for mname, m in self.methods.items():
+            if not isinstance(m, Method):
+                raise bad(f"method {mname!r} must be a nonsmooth.models.Method")
+            for part in ("field", "jacobian", "guards", "transition", "initial"):
+                if not callable(getattr(m, part)):
+                    raise bad(f"method {mname!r}: {part} is missing (a function is needed)")
+            for mode in m.modes:
+                if not 0 <= mode < len(self.mode_names):
+                    raise bad(f"method {mname!r}: mode {mode} is not one of the "
+                              f"{len(self.mode_names)} modes")
+        object.__setattr__(self, "_compiled", {})
+
+    # ---- parameters ----
+    @property
+    def param_names(self) -> tuple:
+        return tuple(p.name for p in self.parameters)
+
+    @property
+    def index(self) -> dict:
+        return param_index(self.parameters)
+
+    @property
+    def n(self) -> int:
+        return len(self.state_names)
+
+    def param(self, name: str) -> Param:
+        for p in self.parameters:
+            if p.name == name:
+                return p
+        raise ParameterError(self.unknown_message(name))
+
+    def unknown_message(self, name: str) -> str:
+        other = [m for m in _other_models_with(name) if m != self.name]
+        where = f" (a parameter of {', '.join(other)})" if other else ""
+        return (f"{name}: not a parameter of model {self.name!r}{where}; its parameters: "
+                f"{', '.join(self.param_names)}")
+
+    def validate(self, values: dict) -> dict:
+        """Checked values (defaults filled in), in parameter order; one-line errors."""
+        for k in values:
+            if k not in self.param_names:
+                raise ParameterError(self.unknown_message(k))
+        out = {}
+        for p in self.parameters:
+            if p.name in values:
+                out[p.name] = p.check(values[p.name])
+            elif p.default is not None:
+                out[p.name] = float(p.default)
+            else:
+                raise ParameterError(f"{p.name}: required by model {self.name!r} "
+                                     f"({p.long_name or 'no default'}; {p.range_text})")
+        if self.check is not None:
+            self.check(out)
+        return out
+
+    def params(self, **values):
+        """Validated parameters of this model (defaults for the ones not given)."""
+        if self.params_class is not None:
+            return self.params_class(**self.validate(values))
+        return ModelParams(self, **values)
+
+    def preset(self, name: str):
+        try:
+            values, _ = self.presets[name]
+        except KeyError:
+            raise ParameterError(f"preset: unknown preset {name!r} of model {self.name!r} "
+                                 f"(known: {', '.join(self.presets) or 'none'})") from None
+        return self.params(**values)
+
+    def params_from_attrs(self, source, **point):
+        """The parameters of a result (``param_<name>`` attrs; swept ones given in ``point``)."""
+        variables = getattr(source, "variables", {})
+        attrs = getattr(source, "attrs", source)
+        for k in point:
+            if k not in self.param_names:
+                raise ParameterError(self.unknown_message(k))
+        values = {}
+        for n in self.param_names:
+            if n in point:
+                values[n] = point[n]
+            elif n in variables:
+                raise ParameterError(f"{n}: swept in this dataset; give the point, e.g. "
+                                     f"from_attrs(ds, {n}=...)")
+            elif f"param_{n}" in attrs:
+                values[n] = float(attrs[f"param_{n}"])
+            else:
+                raise ParameterError(f"{n}: no param_{n} attribute (a swept parameter?); give "
+                                     f"its value, e.g. from_attrs(attrs, {n}=...)")
+        return self.params(**values)
+
+    # ---- methods ----
+    def method(self, name: str) -> Method:
+        try:
+            return self.methods[name]
+        except KeyError:
+            raise ParameterError(f"method: model {self.name!r} has no method {name!r} "
+                                 f"(known: {', '.join(self.methods)})") from None
+
+    def fns(self, method: str) -> tuple:
+        """The compiled functions of ``method`` (cached): the ``fns`` tuple of the generic
+        kernel."""
+        cache = self._compiled
+        if method not in cache:
+            cache[method] = compile_method(self, method)
+        return cache[method]
+
+    def is_contact(self, params, mask: int, max_X: float, min_X: float) -> bool:
+        """Does an orbit with visited-mode ``mask`` and these extremes count as contact?"""
+        if self.contact is not None:
+            return bool(self.contact(params, int(mask), float(max_X), float(min_X)))
+        return bool(int(mask) & self.contact_modes)
+
+    def plot_lines(self, params, method: str) -> list:
+        """[(X value, label), ...] to draw on time responses and sections."""
+        return list(self.lines(params, method)) if self.lines is not None else []
+
+    def summary(self) -> dict:
+        return {"name": self.name, "description": self.description,
+                "parameters": {p.name: dict(default=p.default, range=p.range_text,
+                                            units=p.units, long_name=p.long_name)
+                               for p in self.parameters},
+                "methods": list(self.methods), "modes": list(self.mode_names),
+                "state": list(self.state_names), "references": list(self.references),
+                "presets": list(self.presets), "source": self.source}
+
+
+# ---- compiling a method ----------------------------------------------------------------------
+def compile_method(model: Model, method: str) -> tuple:
+    """Compile the functions of ``model.methods[method]`` as cached ``cfunc`` s and check them
+    at a sample point (defaults of the parameters, u = 0.5, mem = 0) for every mode: field
+    finite, Jacobian equal to finite differences of the field, guard count within bounds,
+    transitions into known modes. One ParameterError naming the model, method and function
+    otherwise."""
+    import numba as nb
+
+    from ..integrate.contract import MAX_GUARDS, MODEL_SIGNATURES
+    m = model.method(method)
+    parts = ("field", "jacobian", "guards", "transition", "initial", "linear")
+    fns = []
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", nb.NumbaExperimentalFeatureWarning)
+        for part, sig in zip(parts, MODEL_SIGNATURES):
+            fn = getattr(m, part) or _no_linear
+            try:
+                fns.append(nb.cfunc(sig, cache=True)(fn))
+            except Exception as exc:
+                raise ParameterError(f"model {model.name}: {method}.{part} "
+                                     f"({getattr(fn, '__name__', part)}) does not compile with "
+                                     f"numba: {_numba_reason(exc)}") from None
+    fns = tuple(fns)
+    _sample_check(model, method, m, fns, MAX_GUARDS)
+    return fns
+
+
+def _numba_reason(exc) -> str:
+    """The informative line of a numba compilation error, with its source location."""
+    lines = [ln.strip() for ln in str(exc).splitlines() if ln.strip()]
+    skip = ("Failed in ", "During:", "<source elided>", "^")
+    reason = next((ln for ln in lines if not ln.startswith(skip) and not ln.startswith("File ")),
+                  type(exc).__name__)
+    where = next((ln.replace('"', "") for ln in lines if ln.startswith("File ")), "")
+    return f"{reason} ({where})" if where else reason
+
+
+def _sample_check(model, method, m, fns, max_guards):
+    from ._probe import call_field, call_guards, call_jacobian, call_transition
+    n = model.n
+    bad = lambda msg: ParameterError(f"model {model.name}: {method}.{msg}")  # noqa: E731
+    try:
+        p = model.params().pack()
+    except ParameterError:
+        return  # no complete defaults: nothing to sample
+    mem = np.zeros(max(1, model.n_memory))
+    u = np.full(n, 0.5)
+    du = np.zeros(n)
+    J = np.zeros((n, n))
+    G = np.zeros((max_guards, n + 3))
+    t, c, s = 0.1, math.cos(0.1), math.sin(0.1)
+    for mode in (m.modes or tuple(range(len(model.mode_names)))):
+        name = model.mode_names[mode]
+        call_field(fns, mode, t, c, s, u, p, mem, du)
+        if not np.all(np.isfinite(du)):
+            raise bad(f"field is not finite in mode {name} at the sample point u = 0.5")
+        call_jacobian(fns, mode, t, c, s, u, p, mem, J)
+        fd = np.empty((n, n))
+        for j in range(n):
+            h = 1e-6 * max(1.0, abs(u[j]))
+            up, um, dp, dm = u.copy(), u.copy(), np.empty(n), np.empty(n)
+            up[j] += h
+            um[j] -= h
+            call_field(fns, mode, t, c, s, up, p, mem, dp)
+            call_field(fns, mode, t, c, s, um, p, mem, dm)
+            fd[:, j] = (dp - dm) / (2 * h)
+        scale = max(1.0, float(np.max(np.abs(fd))))
+        if not np.all(np.abs(J - fd) <= 1e-5 * scale):
+            i, j = np.unravel_index(np.argmax(np.abs(J - fd)), J.shape)
+            raise bad(f"jacobian disagrees with the field in mode {name}: J[{i},{j}] = "
+                      f"{J[i, j]:.6g}, finite differences give {fd[i, j]:.6g}")
+        ng = int(call_guards(fns, mode, p, mem, G))
+        if not 0 <= ng <= max_guards:
+            raise bad(f"guards returns {ng} surfaces in mode {name} (allowed 0..{max_guards})")
+        for k in range(ng):
+            new = int(call_transition(fns, mode, k, t, c, s, u.copy(), p, mem.copy()))
+            if not 0 <= new < len(model.mode_names):
+                raise bad(f"transition from mode {name} through surface {k} goes to unknown "
+                          f"mode {new} (modes: 0..{len(model.mode_names) - 1})")
+
+
+# ---- registry --------------------------------------------------------------------------------
+#: Built-in models: name -> module defining ``MODEL``.
+BUILTIN = {
+    "support": "nonsmooth.models.support",
+    "two_sided": "nonsmooth.models.two_sided",
+    "impact": "nonsmooth.models.impact",
+    "stick_slip": "nonsmooth.models.stick_slip",
+}
+
+#: Parameter names of the built-in models (for "a parameter of another model" messages),
+#: filled as models load.
+_PARAM_NAMES: dict = {}
+
+
+def _other_models_with(name: str) -> list:
+    return [m for m, names in _PARAM_NAMES.items() if name in names]

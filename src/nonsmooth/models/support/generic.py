@@ -1,0 +1,246 @@
+"""The support model through the model interface (:mod:`nonsmooth.models.base`).
+
+These functions describe the same model as the specialised kernels (``smooth_kernel``,
+``exact_kernel``) so that the generic kernel can run it too; the tests check the two against
+each other. Memory: ``mem[0]`` = Va, the entry velocity into Sigma_alpha (eq. 13a);
+``mem[1]`` = which inequality of a union region holds (Gamma- is {h_alpha <= -eta} or
+{h_beta >= eta}; free flight of the exact model is below X = 1 or above it after a
+separation), because the guards of a mode describe an intersection of half-planes.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numba as nb
+
+from ...params import IDX
+from .switch import GAMMA_MINUS, GAMMA_PLUS, SIGMA_ALPHA, SIGMA_BETA, beta_ratio, region
+
+N_MEMORY = 2
+_W0, _WS, _XI, _XIS, _F0, _ETA = (IDX[k] for k in ("omega0", "omega_s", "xi", "xi_s", "F0",
+                                                   "eta"))
+_FREE = 0
+_CONTACT = 3
+
+
+@nb.njit(cache=True, inline="always")
+def _row(G, k, a, b, c):
+    G[k, 0] = a
+    G[k, 1] = b
+    G[k, 2] = c
+    G[k, 3] = 0.0
+    G[k, 4] = 0.0
+
+
+# ---- smooth (switch model, eq. 13) ----------------------------------------------------------
+def smooth_field(mode, t, c, s, u, p, mem, du):
+    w02 = p[_W0] * p[_W0]
+    ws2 = p[_WS] * p[_WS]
+    xi, xis, eta = p[_XI], p[_XIS], p[_ETA]
+    X, V = u[0], u[1]
+    a = -w02 * X - xi * V + p[_F0] * c
+    if mode == GAMMA_PLUS:
+        a += -ws2 * (X - 1.0) - xis * V
+    elif mode == SIGMA_ALPHA:
+        q = (X - 1.0 + eta) / (2.0 * eta)
+        a += -xis * V - 0.5 * ws2 * (X - 1.0 + eta) + xis * mem[0] * (1.0 - q)
+    elif mode == SIGMA_BETA:
+        a += -0.5 * ws2 * (X - 1.0 + eta) - 0.5 * xis * V
+    du[0] = V
+    du[1] = a
+    return 0
+
+
+def smooth_jacobian(mode, t, c, s, u, p, mem, J):
+    w02 = p[_W0] * p[_W0]
+    ws2 = p[_WS] * p[_WS]
+    xi, xis, eta = p[_XI], p[_XIS], p[_ETA]
+    ax, av = -w02, -xi
+    if mode == GAMMA_PLUS:
+        ax, av = ax - ws2, av - xis
+    elif mode == SIGMA_ALPHA:
+        ax, av = ax - 0.5 * ws2 - xis * mem[0] / (2.0 * eta), av - xis
+    elif mode == SIGMA_BETA:
+        ax, av = ax - 0.5 * ws2, av - 0.5 * xis
+    J[0, 0] = 0.0
+    J[0, 1] = 1.0
+    J[1, 0] = ax
+    J[1, 1] = av
+    return 0
+
+
+def smooth_guards(mode, p, mem, G):
+    # h_alpha = X - 1, h_beta = -(X - 1) - r V; every row >= 0 inside the region (eq. 14)
+    r = beta_ratio(p[_WS], p[_XIS])
+    eta = p[_ETA]
+    if mode == GAMMA_MINUS:
+        if mem[1] == 0.0:
+            _row(G, 0, -1.0, 0.0, 1.0 - eta)  # -eta - h_alpha >= 0
+        else:
+            _row(G, 0, -1.0, -r, 1.0 - eta)  # h_beta - eta >= 0
+        return 1
+    if mode == SIGMA_ALPHA:
+        _row(G, 0, 1.0, 0.0, eta - 1.0)  # h_alpha + eta
+        _row(G, 1, -1.0, 0.0, 1.0 + eta)  # eta - h_alpha
+        _row(G, 2, 0.0, r, 0.0)  # -h_alpha - h_beta = r V
+        return 3
+    if mode == SIGMA_BETA:
+        _row(G, 0, 0.0, -r, 0.0)  # h_alpha + h_beta = -r V
+        _row(G, 1, -1.0, -r, 1.0 + eta)  # h_beta + eta
+        _row(G, 2, 1.0, r, eta - 1.0)  # eta - h_beta
+        return 3
+    _row(G, 0, 1.0, 0.0, -1.0 - eta)  # h_alpha - eta
+    _row(G, 1, 1.0, r, -1.0 - eta)  # -eta - h_beta
+    return 2
+
+
+@nb.njit(cache=True)
+def _enter(new, old, X, V, eta, mem):
+    if new == SIGMA_ALPHA and old != SIGMA_ALPHA:
+        mem[0] = V
+    if new == GAMMA_MINUS:
+        mem[1] = 0.0 if X - 1.0 <= -eta else 1.0
+
+
+def smooth_transition(mode, k, t, c, s, u, p, mem):
+    r = beta_ratio(p[_WS], p[_XIS])
+    eta = p[_ETA]
+    X, V = u[0], u[1]
+    if mode == GAMMA_MINUS:
+        # one inequality of the union stopped holding: stay if the other holds
+        if mem[1] == 0.0 and -(X - 1.0) - r * V >= eta:
+            mem[1] = 1.0
+            return GAMMA_MINUS
+        if mem[1] == 1.0 and X - 1.0 <= -eta:
+            mem[1] = 0.0
+            return GAMMA_MINUS
+    # the region just across the crossed surface: classify a point nudged outwards
+    a = 0.0  # outward normal of the crossed surface (the direction of decreasing g_k)
+    b = 0.0
+    if mode == GAMMA_MINUS:
+        a = 1.0
+        b = 0.0 if mem[1] == 0.0 else r
+    elif mode == SIGMA_ALPHA:
+        if k == 0:
+            a = -1.0
+        elif k == 1:
+            a = 1.0
+        else:
+            b = -r
+    elif mode == SIGMA_BETA:
+        if k == 0:
+            b = r
+        elif k == 1:
+            a = 1.0
+            b = r
+        else:
+            a = -1.0
+            b = -r
+    elif k == 0:
+        a = -1.0
+    else:
+        a = -1.0
+        b = -r
+    d = 1e-12 * max(1.0, eta) / max(1e-300, math.sqrt(a * a + b * b))
+    new = region(X + d * a, V + d * b, eta, r)
+    if new == mode:
+        new = region(X + 1e3 * d * a, V + 1e3 * d * b, eta, r)
+    _enter(new, mode, X, V, eta, mem)
+    return new
+
+
+def smooth_initial(c, s, u, p, mem):
+    r = beta_ratio(p[_WS], p[_XIS])
+    eta = p[_ETA]
+    mode = region(u[0], u[1], eta, r)
+    mem[0] = u[1]
+    mem[1] = 0.0 if u[0] - 1.0 <= -eta else 1.0
+    return mode
+
+
+# ---- exact (eta = 0) ------------------------------------------------------------------------
+@nb.njit(cache=True)
+def _has_support(p):
+    return p[_WS] > 0.0 or p[_XIS] > 0.0
+
+
+def exact_field(mode, t, c, s, u, p, mem, du):
+    X, V = u[0], u[1]
+    a = -p[_W0] * p[_W0] * X - p[_XI] * V + p[_F0] * c
+    if mode == _CONTACT:
+        a += -p[_WS] * p[_WS] * (X - 1.0) - p[_XIS] * V
+    du[0] = V
+    du[1] = a
+    return 0
+
+
+def exact_jacobian(mode, t, c, s, u, p, mem, J):
+    J[0, 0] = 0.0
+    J[0, 1] = 1.0
+    J[1, 0] = -p[_W0] * p[_W0] - (p[_WS] * p[_WS] if mode == _CONTACT else 0.0)
+    J[1, 1] = -p[_XI] - (p[_XIS] if mode == _CONTACT else 0.0)
+    return 0
+
+
+def exact_guards(mode, p, mem, G):
+    if not _has_support(p):
+        return 0
+    r = beta_ratio(p[_WS], p[_XIS])
+    if mode == _CONTACT:
+        _row(G, 0, 1.0, r, -1.0)  # support force / omega_s^2 = -h_beta >= 0
+        return 1
+    if mem[0] == 0.0:  # free, below the support
+        _row(G, 0, -1.0, 0.0, 1.0)  # -h_alpha >= 0
+        return 1
+    _row(G, 0, -1.0, -r, 1.0)  # free above X = 1 after a separation: h_beta >= 0
+    _row(G, 1, 1.0, 0.0, -1.0)  # and h_alpha >= 0
+    return 2
+
+
+def exact_transition(mode, k, t, c, s, u, p, mem):
+    X, V = u[0], u[1]
+    if mode == _CONTACT:
+        mem[0] = 1.0 if X > 1.0 else 0.0
+        return _FREE
+    if mem[0] == 0.0:  # reached X = 1: contact if moving in (V <= 0 is a grazing touch)
+        if V > 0.0:
+            return _CONTACT
+        mem[0] = 1.0
+        return _FREE
+    if k == 0 and X > 1.0:  # the support force turns positive again
+        return _CONTACT
+    mem[0] = 0.0
+    return _FREE
+
+
+def exact_initial(c, s, u, p, mem):
+    X, V = u[0], u[1]
+    mode = _FREE
+    if _has_support(p):
+        ha = X - 1.0
+        ws2 = p[_WS] * p[_WS]
+        Fs = ws2 * ha + p[_XIS] * V
+        if (ha > 0.0 and Fs > 0.0) or (ha == 0.0 and V > 0.0):
+            mode = _CONTACT
+        elif ha > 0.0 and Fs == 0.0:
+            A = -p[_W0] * p[_W0] * X - p[_XI] * V + p[_F0] * c
+            if ws2 * V + p[_XIS] * A > 0.0:
+                mode = _CONTACT
+    mem[0] = 1.0 if (mode == _FREE and X > 1.0) else 0.0
+    return mode
+
+
+def exact_linear(mode, p, out):
+    w02 = p[_W0] * p[_W0]
+    if mode == _CONTACT:
+        ws2 = p[_WS] * p[_WS]
+        out[0] = w02 + ws2
+        out[1] = p[_XI] + p[_XIS]
+        out[2] = ws2
+    else:
+        out[0] = w02
+        out[1] = p[_XI]
+        out[2] = 0.0
+    out[3] = p[_F0]
+    return 1

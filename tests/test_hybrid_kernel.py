@@ -1,0 +1,331 @@
+"""Generic hybrid kernel (``integrate.hybrid.advance_generic``) on toy models defined here."""
+
+import math
+import warnings
+
+import numba as nb
+import numpy as np
+import pytest
+
+warnings.filterwarnings("ignore", category=nb.NumbaExperimentalFeatureWarning)
+
+from nonsmooth import status as st  # noqa: E402
+from nonsmooth.integrate.contract import (  # noqa: E402
+    MODEL_SIGNATURES,
+    N_OPTS,
+    N_STATE,
+    OPT_ATOL,
+    OPT_CLOSED_FORM,
+    OPT_MAX_STEPS,
+    OPT_N,
+    OPT_NMEM,
+    OPT_OMEGA,
+    OPT_RTOL,
+    ST_EXTRA,
+    ST_H,
+    ST_MODE,
+    ST_V,
+    ST_X,
+)
+from nonsmooth.integrate.hybrid import advance_generic  # noqa: E402
+
+pytestmark = pytest.mark.filterwarnings("ignore::numba.NumbaExperimentalFeatureWarning")
+
+FIELD, JAC, GUARDS, TRANS, INIT, LIN = MODEL_SIGNATURES
+
+# ---- toy models; p = (w0, xi, F0, omega, r, b) ----------------------------------------------
+P_W0, P_XI, P_F0, P_OM, P_R, P_B = range(6)
+
+
+@nb.cfunc(FIELD, cache=False)
+def osc_field(mode, t, c, s, u, p, mem, du):
+    """X'' + xi X' + w0^2 X = F0 cos(omega t) + b; u[2:] decay as dz/dt = -z."""
+    du[0] = u[1]
+    du[1] = -p[0] * p[0] * u[0] - p[1] * u[1] + p[2] * c + p[5]
+    for i in range(2, u.shape[0]):
+        du[i] = -u[i]
+    return 0
+
+
+@nb.cfunc(JAC, cache=False)
+def no_jac(mode, t, c, s, u, p, mem, J):
+    return 0
+
+
+@nb.cfunc(GUARDS, cache=False)
+def no_guards(mode, p, mem, G):
+    return 0
+
+
+@nb.cfunc(GUARDS, cache=False)
+def stop_guard(mode, p, mem, G):
+    """g = 1 - X >= 0 (rigid stop at X = 1); columns (u..., const, cos, sin)."""
+    n = G.shape[1] - 3
+    for i in range(G.shape[1]):
+        G[0, i] = 0.0
+    G[0, 0] = -1.0
+    G[0, n] = 1.0
+    return 1
+
+
+@nb.cfunc(TRANS, cache=False)
+def impact(mode, k, t, c, s, u, p, mem):
+    """Newton impact V -> -r V; counts impacts in mem[0] and stores their times in mem[1:]."""
+    u[1] = -p[4] * u[1]
+    i = int(mem[0])
+    if i + 1 < mem.shape[0]:
+        mem[i + 1] = t
+    mem[0] = i + 1.0
+    return 0
+
+
+@nb.cfunc(TRANS, cache=False)
+def stuck(mode, k, t, c, s, u, p, mem):
+    """A transition that does not resolve the exit (the guard stays violated)."""
+    return mode
+
+
+@nb.cfunc(INIT, cache=False)
+def init_free(c, s, u, p, mem):
+    return 0
+
+
+@nb.cfunc(LIN, cache=False)
+def osc_linear(mode, p, out):
+    out[0] = p[0] * p[0]
+    out[1] = p[1]
+    out[2] = p[5]
+    out[3] = p[2]
+    return 1
+
+
+# a switching model: mode 0 (X <= 1, free), mode 1 (X >= 1, spring contact k_s = 4, c_s = 0.2)
+@nb.cfunc(FIELD, cache=False)
+def sw_field(mode, t, c, s, u, p, mem, du):
+    du[0] = u[1]
+    a = -p[0] * p[0] * u[0] - p[1] * u[1] + p[2] * c
+    if mode == 1:
+        a += -4.0 * (u[0] - 1.0) - 0.2 * u[1]
+    du[1] = a
+    return 0
+
+
+@nb.cfunc(GUARDS, cache=False)
+def sw_guards(mode, p, mem, G):
+    for i in range(5):
+        G[0, i] = 0.0
+    if mode == 0:
+        G[0, 0] = -1.0
+        G[0, 2] = 1.0
+    else:
+        G[0, 0] = 1.0
+        G[0, 2] = -1.0
+    return 1
+
+
+@nb.cfunc(TRANS, cache=False)
+def sw_trans(mode, k, t, c, s, u, p, mem):
+    mem[0] += 1.0
+    return 1 - mode
+
+
+@nb.cfunc(INIT, cache=False)
+def sw_init(c, s, u, p, mem):
+    return 1 if u[0] > 1.0 else 0
+
+
+@nb.cfunc(LIN, cache=False)
+def sw_linear(mode, p, out):
+    if mode == 0:
+        out[0] = p[0] * p[0]
+        out[1] = p[1]
+        out[2] = 0.0
+    else:
+        out[0] = p[0] * p[0] + 4.0
+        out[1] = p[1] + 0.2
+        out[2] = 4.0
+    out[3] = p[2]
+    return 1
+
+
+LINEAR = (osc_field, no_jac, no_guards, impact, init_free, osc_linear)
+IMPACT = (osc_field, no_jac, stop_guard, impact, init_free, osc_linear)
+SWITCH = (sw_field, no_jac, sw_guards, sw_trans, sw_init, sw_linear)
+STUCK = (osc_field, no_jac, stop_guard, stuck, init_free, osc_linear)
+
+
+def make_opts(rtol=1e-10, atol=1e-12, n=2, nmem=0, closed=False, max_steps=100_000):
+    o = np.zeros(N_OPTS)
+    o[OPT_RTOL] = rtol
+    o[OPT_ATOL] = atol
+    o[OPT_MAX_STEPS] = max_steps
+    o[OPT_OMEGA] = P_OM
+    o[OPT_N] = n
+    o[OPT_NMEM] = nmem
+    o[OPT_CLOSED_FORM] = 1.0 if closed else 0.0
+    return o
+
+
+def make_state(X, V, extra=(), mem=(), mode=-1):
+    s = np.zeros(N_STATE)
+    s[ST_X] = X
+    s[ST_V] = V
+    s[ST_MODE] = mode
+    s[ST_H] = 0.0
+    s[ST_EXTRA:ST_EXTRA + len(extra)] = extra
+    s[ST_EXTRA + len(extra):ST_EXTRA + len(extra) + len(mem)] = mem
+    return s
+
+
+def run(fns, p, opts, state, per_period=1, n_skip=0, n_out=1):
+    X = np.empty(n_out)
+    V = np.empty(n_out)
+    R = np.empty(n_out, np.int8)
+    M = np.empty(n_out, np.uint8)
+    Xmax = np.empty(n_out)
+    Xmin = np.empty(n_out)
+    code = advance_generic(fns, np.asarray(p, float), opts, state, per_period, n_skip, n_out, X,
+                           V, R, M, Xmax, Xmin)
+    return code, X, V, R, M, Xmax, Xmin
+
+
+def params(w0=1.3, xi=0.1, F0=0.7, om=1.0, r=0.8, b=0.0):
+    return np.array([w0, xi, F0, om, r, b])
+
+
+def steady(p):
+    """Analytic steady state of the forced linear oscillator at t = 0 (mod T): amplitude and
+    phase, X = a cos(omega t - phi)."""
+    w0, xi, F0, om = p[P_W0], p[P_XI], p[P_F0], p[P_OM]
+    a = F0 / math.sqrt((w0 * w0 - om * om) ** 2 + (xi * om) ** 2)
+    phi = math.atan2(xi * om, w0 * w0 - om * om)
+    return a * math.cos(-phi), -a * om * math.sin(-phi), a
+
+
+@pytest.mark.parametrize("closed,tol", [(False, 1e-7), (True, 1e-12)])
+def test_linear_oscillator_steady_state(closed, tol):
+    p = params()
+    X0, V0, a = steady(p)
+    state = make_state(X0 + 0.3, V0 - 0.2)  # with a transient that decays (xi = 0.1)
+    p2 = params(xi=0.6)  # faster decay: exp(-0.3 * 50 * 2 pi) ~ 1e-41
+    X0, V0, a = steady(p2)
+    code, X, V, R, M, Xmax, Xmin = run(LINEAR, p2, make_opts(closed=closed), state,
+                                       per_period=4, n_skip=196, n_out=4)
+    assert code == st.OK
+    assert abs(X[-1] - X0) < tol and abs(V[-1] - V0) < tol
+    assert np.all(R == 0) and np.all(M == 1)
+    # extremes over a full period are +-a (interior extrema located)
+    assert abs(Xmax.max() - a) < 100 * tol and abs(Xmin.min() + a) < 100 * tol
+    # starting exactly on the orbit: the stroboscopic point is a fixed point
+    state = make_state(X0, V0)
+    code, X, V, *_ = run(LINEAR, p2, make_opts(closed=closed), state, n_out=50)
+    assert code == st.OK
+    assert np.max(np.abs(X - X0)) < tol and np.max(np.abs(V - V0)) < tol
+
+
+@pytest.mark.parametrize("fns,closed", [(SWITCH, False), (SWITCH, True), (IMPACT, False),
+                                        (IMPACT, True)])
+def test_split_invariance(fns, closed):
+    p = params(w0=1.0, xi=0.05, F0=1.0, om=0.8)
+    opts = make_opts(rtol=1e-8, atol=1e-10, nmem=1, closed=closed)
+    s1 = make_state(0.2, 0.0, mem=(0.0,))
+    one = run(fns, p, opts, s1, per_period=5, n_skip=0, n_out=50)
+    s2 = make_state(0.2, 0.0, mem=(0.0,))
+    a = run(fns, p, opts, s2, per_period=5, n_skip=35, n_out=0)
+    b = run(fns, p, opts, s2, per_period=5, n_skip=0, n_out=15)
+    assert one[0] == a[0] == b[0] == st.OK
+    for k in range(1, 7):
+        assert np.array_equal(one[k][35:], b[k])
+    assert np.array_equal(s1, s2)
+    assert s1[ST_EXTRA] >= 5  # switches (or impacts) happened and were counted
+    if fns is SWITCH:
+        assert np.any(one[4] == 3)  # both modes visited within some interval
+    else:
+        assert np.all(one[4] == 1)  # impacts keep the mode
+
+
+def _scipy_impacts(p, X0, V0, t_end):
+    from scipy.integrate import solve_ivp
+
+    w0, F0, om, r = p[P_W0], p[P_F0], p[P_OM], p[P_R]
+    xi = p[P_XI]
+
+    def f(t, y):
+        return [y[1], -w0 * w0 * y[0] - xi * y[1] + F0 * math.cos(om * t)]
+
+    def ev(t, y):
+        return y[0] - 1.0
+
+    ev.terminal = True
+    ev.direction = 1.0
+    t0, y0 = 0.0, [X0, V0]
+    times, states = [], []
+    while t0 < t_end:
+        sol = solve_ivp(f, (t0, t_end), y0, method="DOP853", rtol=1e-12, atol=1e-12,
+                        events=ev, dense_output=True)
+        if sol.status == 1:
+            te = sol.t_events[0][0]
+            ye = sol.y_events[0][0]
+            times.append(te)
+            states.append(ye.copy())
+            t0, y0 = te, [1.0, -r * ye[1]]
+        else:
+            return times, states, sol.y[:, -1]
+    return times, states, np.array(y0)
+
+
+@pytest.mark.parametrize("closed", [False, True])
+def test_impact_oscillator_vs_scipy(closed):
+    p = params(w0=1.0, xi=0.05, F0=1.0, om=0.8, r=0.8)
+    T = 2 * math.pi / p[P_OM]
+    n_per = 5
+    times, states, y_end = _scipy_impacts(p, 0.0, 0.0, n_per * T)
+    assert len(times) >= 3
+    opts = make_opts(rtol=1e-11, atol=1e-13, nmem=10, closed=closed)
+    state = make_state(0.0, 0.0, mem=(0.0,) * 10)
+    got = []
+    for k in range(n_per):  # one period per call, impact times from the model's memory
+        state[ST_EXTRA:ST_EXTRA + 10] = 0.0
+        code, X, V, R, M, Xmax, Xmin = run(IMPACT, p, opts, state)
+        assert code == st.OK
+        got += [k * T + state[ST_EXTRA + 1 + i] for i in range(int(state[ST_EXTRA]))]
+        assert Xmax[0] <= 1.0 + 1e-9  # Hermite extrema: interpolation error ~ tolerance
+    assert len(got) == len(times)
+    assert np.max(np.abs(np.array(got) - np.array(times))) < 1e-7
+    assert abs(state[ST_X] - y_end[0]) < 1e-7 and abs(state[ST_V] - y_end[1]) < 1e-7
+
+
+def test_three_dimensional_state_and_memory():
+    p = params(xi=0.6)
+    X0, V0, a = steady(p)
+    opts = make_opts(n=3, nmem=2)
+    state = make_state(X0, V0, extra=(1.0,), mem=(0.0, 0.0))
+    code, X, V, *_ = run(LINEAR, p, opts, state, n_out=3)
+    assert code == st.OK
+    T = 2 * math.pi / p[P_OM]
+    assert abs(state[ST_EXTRA] - math.exp(-3 * T)) < 1e-9 * math.exp(-3 * T) + 1e-14
+    assert abs(X[-1] - X0) < 1e-7 and abs(V[-1] - V0) < 1e-7
+    # impacts with n = 3: the memory slots written by transition come back in state
+    p = params(w0=1.0, xi=0.05, F0=1.0, om=0.8)
+    state = make_state(0.0, 0.0, extra=(1.0,), mem=(0.0, 0.0))
+    code, *_ = run(IMPACT, p, opts, state, n_out=2)
+    assert code == st.OK
+    assert state[ST_EXTRA + 1] >= 1.0  # impact count
+    assert 0.0 < state[ST_EXTRA + 2] < 2 * math.pi / 0.8  # first impact time (local)
+
+
+def test_non_finite_and_zeno():
+    p = params()
+    code, *_ = run(LINEAR, p, make_opts(), make_state(np.nan, 0.0))
+    assert code == st.NON_FINITE
+    # a ball pushed onto the stop by a constant force bounces with ever shorter flights
+    # (Zeno time 1 + 1.6 / 0.2 = 9 < 2 T)
+    p = params(w0=0.0, xi=0.0, F0=0.0, om=1.0, r=0.8, b=1.0)
+    state = make_state(0.5, 0.0, mem=(0.0,))
+    code, *_ = run(IMPACT, p, make_opts(nmem=1), state, n_out=3)
+    assert code == st.ZENO
+    assert state[ST_EXTRA] > 64 and abs(state[ST_X] - 1.0) < 1e-9
+    # a transition that leaves the guard violated: ZENO, not a hang
+    p = params(w0=1.0, xi=0.0, F0=0.0, om=1.0, b=2.0)
+    code, *_ = run(STUCK, p, make_opts(), make_state(0.5, 0.0))
+    assert code == st.ZENO
