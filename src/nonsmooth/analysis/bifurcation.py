@@ -24,7 +24,8 @@ from ..errors import ParameterError
 from ..io import provenance_attrs
 from ..integrate.contract import MODEL_FNS_TYPE
 from ..kernels import Solver, mode_holds, run
-from ..params import Params, check_param_name
+from ..models.base import ParamsBase
+from ..params import check_param_name
 from .poincare import MAX_PERIOD, PERIOD_LONG_NAME, SETTLE_WINDOW, classify, settle, settle_tolerance
 
 SWEEPS = ("up", "down", "both", "fresh")
@@ -132,7 +133,7 @@ def check_values(name: str, values) -> np.ndarray:
     return v
 
 
-def param_rows(params: Params, param: str, values) -> np.ndarray:
+def param_rows(params: ParamsBase, param: str, values) -> np.ndarray:
     """Packed parameters, one row per value. Every constraint of Params is an interval in
     each parameter, so validating the smallest and the largest value validates them all."""
     values = np.asarray(values, dtype=np.float64)
@@ -187,7 +188,7 @@ def follow(P, solver: Solver, states, init, transient: int, settle_tol: float, r
     return out
 
 
-def run_branches(params: Params, param: str, values, solver: Solver, *, directions,
+def run_branches(params: ParamsBase, param: str, values, solver: Solver, *, directions,
                  transient: int, record: int, x0: float, v0: float, settle: bool,
                  workers=None, progress=None, chunk: int = 25):
     """Run continuation branches over sorted ``values``; ``directions`` lists "up", "down"
@@ -284,7 +285,7 @@ def summarize(out, rows, solver: Solver, transient: int, record: int, workers=No
     return period, mx, mn, contact
 
 
-def bifurcation_diagram(params: Params, param: str, values, *, sweep: str = "both",
+def bifurcation_diagram(params: ParamsBase, param: str, values, *, sweep: str = "both",
                         transient: int = 500, record: int = 200, method: str = "smooth",
                         x0: float = 0.0, v0: float = 0.0, rtol: float = 1e-8,
                         atol: float = 1e-10, transition: str = "eq13", settle: bool = True,

@@ -38,7 +38,7 @@ import xarray as xr
 from ..errors import ParameterError
 from ..io import provenance_attrs
 from ..kernels import Solver, new_state
-from ..models.base import ParamsBase as Params
+from ..models.base import ParamsBase
 from ..sweep import run_trajectories
 from .periodicity import detect_period, section_tolerance
 
@@ -108,7 +108,7 @@ def _integrate(P, solver, x0, v0, transient, record, orbit_periods, spp, workers
     return sec, por, status
 
 
-def eta_study(params: Params, etas, *, transient: int = 300, record: int | None = None,
+def eta_study(params: ParamsBase, etas, *, transient: int = 300, record: int | None = None,
               orbit_periods: int | None = None, samples_per_period: int = 200, x0: float = 0.0,
               v0: float = 0.0, rtol: float = 1e-8, atol: float = 1e-10,
               distance_tol: float = 1e-3, transition: str = "eq13",

@@ -55,7 +55,7 @@ from ..errors import IntegrationError
 from ..integrate.contract import ST_MODE
 from ..io import provenance_attrs
 from ..kernels import Solver, run
-from ..params import Params
+from ..models.base import ParamsBase
 from .periodicity import NOT_SETTLED, detect_period, section_tolerance, still_converging
 
 #: Largest period the period detection looks for.
@@ -176,7 +176,7 @@ def classify(X, V, Xmax, Xmin, M, rtol: float, atol: float, max_period: int = MA
     return period, mx, mn, contact, need
 
 
-def poincare(params: Params, *, record: int | None = None, transient: int, x0: float = 0.0,
+def poincare(params: ParamsBase, *, record: int | None = None, transient: int, x0: float = 0.0,
              v0: float = 0.0, method: str = "smooth", rtol: float = 1e-8, atol: float = 1e-10,
              transition: str = "eq13", orbit_samples: int = 200, orbit_periods: int | None = None,
              settle: bool = False, progress=None, points: int | None = None) -> xr.Dataset:

@@ -19,7 +19,8 @@ Definitions (all on the ascending grid of ``omegas``; the continuation core is t
   that touches the end of the grid gives NaN (jump outside the range); no differing value
   gives NaN for both.
 * **omega_a** (contact starts): the smallest grid value at which a branch (up or down) has
-  max_X >= 1 while the same branch had max_X < 1 at the previous value; refined by bisection
+  max_X >= 1 (the model's ``contact_level``: X = 1 for the support; NaN for a model without
+  one) while the same branch had max_X < 1 at the previous value; refined by bisection
   on max_X - 1 along that (non-contact) branch, continued from its state at the last value
   below 1. NaN if no branch crosses 1 from below inside the grid.
 
@@ -37,7 +38,7 @@ import xarray as xr
 
 from ..errors import ParameterError
 from ..kernels import Solver
-from ..params import Params
+from ..models.base import ParamsBase
 from .bifurcation import (branches_dataset, check_sweep_memory, check_values, follow,
                           run_branches)
 from .poincare import settle_tolerance
@@ -63,7 +64,7 @@ def _continue_to(params, solver, starts, target, states, transient, record, sett
     for b, w in enumerate(starts):
         path = np.linspace(w, target, nstep + 1)[1:]
         path[-1] = target
-        P[b] = np.stack([params.replace(omega=float(x)).pack() for x in path])
+        P[b] = np.stack([params.replace(**{params.model.omega: float(x)}).pack() for x in path])
     states = np.array(states, dtype=np.float64, copy=True)
     out = follow(P, solver, states, states[0].copy(), transient, settle_tol, record,
                  workers=workers)
@@ -91,14 +92,15 @@ def _refine_jump(params, solver, w_keep, s_keep, w_gone, s_other, resolution, br
     return 0.5 * (lo + hi), (lo, hi)
 
 
-def _refine_contact(params, solver, w_lo, s_lo, w_hi, resolution, run):
-    """Bisection on max_X - 1 along a branch continued from its state at w_lo (max_X < 1)."""
+def _refine_contact(params, solver, w_lo, s_lo, w_hi, resolution, run, level=1.0):
+    """Bisection on max_X - level along a branch continued from its state at w_lo
+    (max_X < level; ``level`` is where the model's contact starts, X = 1 for the support)."""
     while w_hi - w_lo > resolution:
         mid = 0.5 * (w_lo + w_hi)
         mx, S, ok = _continue_to(params, solver, (w_lo,), mid, s_lo[None, :], *run)
         if not ok:
             return float("nan"), (float("nan"), float("nan"))
-        if mx[0] < 1.0:
+        if mx[0] < level:
             w_lo, s_lo = mid, S[0]
         else:
             w_hi = mid
@@ -142,23 +144,25 @@ def characteristic_frequencies(params, solver, omegas, out, *, transient, record
             res["omega_b"], res["omega_b_bracket"] = _refine_jump(
                 params, solver, omegas[i0], S[1, i0], omegas[i0 - 1], S[0, i0 - 1],
                 resolution, branch_tol, run)
-    # contact onset: first upward crossing of max_X = 1 on either branch
+    # contact onset: first upward crossing of the model's contact level (support: max_X = 1)
+    level = solver.model.contact_level(params) if solver.model.contact_level else None
     best = None
     for b, name in ((0, "up"), (1, "down")):
-        for i in range(1, n):
-            if mx[b, i - 1] < 1.0 <= mx[b, i]:
+        for i in range(1, n if level is not None else 1):
+            if mx[b, i - 1] < level <= mx[b, i]:
                 if best is None or i < best[1]:
                     best = (b, i, name)
                 break
     if best is not None:
         b, i, name = best
         res["omega_a"], res["omega_a_bracket"] = _refine_contact(
-            params, solver, omegas[i - 1], out["S"][b, i - 1], omegas[i], resolution, run)
+            params, solver, omegas[i - 1], out["S"][b, i - 1], omegas[i], resolution, run,
+            level)
         res["omega_a_branch"] = name
     return res
 
 
-def resonance_curve(params: Params, omegas, *, method: str = "smooth", transient: int = 500,
+def resonance_curve(params: ParamsBase, omegas, *, method: str = "smooth", transient: int = 500,
                     record: int = 50, x0: float = 0.0, v0: float = 0.0, rtol: float = 1e-8,
                     atol: float = 1e-10, transition: str = "eq13", settle: bool = True,
                     resolution: float = 1e-4, branch_tol: float = 1e-3,
@@ -174,9 +178,10 @@ def resonance_curve(params: Params, omegas, *, method: str = "smooth", transient
     transient = check_int("transient", transient, 0)
     record = check_int("record", record, 1)
     check_sweep_memory(np.size(omegas), 2, record)
-    omegas = check_values("omega", omegas)
+    w_name = params.model.omega  # the forcing frequency (support: omega)
+    omegas = check_values(w_name, omegas)
     for w in (omegas[0], omegas[-1]):
-        params.replace(omega=float(w))
+        params.replace(**{w_name: float(w)})
     x0 = check_float("x0", x0)
     v0 = check_float("v0", v0)
     resolution = check_float("resolution", resolution)
@@ -187,13 +192,13 @@ def resonance_curve(params: Params, omegas, *, method: str = "smooth", transient
         raise ParameterError(f"branch_tol: must be > 0, got {branch_tol}")
     solver = Solver(method=method, rtol=rtol, atol=atol, transition=transition,
                     model=params.model)
-    out = run_branches(params, "omega", omegas, solver, directions=["up", "down"],
+    out = run_branches(params, w_name, omegas, solver, directions=["up", "down"],
                        transient=transient, record=record, x0=x0, v0=v0, settle=settle,
                        workers=workers, progress=progress)
     freqs = characteristic_frequencies(params, solver, omegas, out, transient=transient,
                                        record=record, settle=settle, workers=workers,
                                        resolution=resolution, branch_tol=branch_tol)
-    ds = branches_dataset(params, "omega", omegas, solver, ["up", "down"], out,
+    ds = branches_dataset(params, w_name, omegas, solver, ["up", "down"], out,
                           analysis="resonance", transient=transient, record=record, x0=x0,
                           v0=v0, settle=settle, resolution=resolution, branch_tol=branch_tol,
                           workers=workers, **freqs)

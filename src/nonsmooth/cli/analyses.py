@@ -9,9 +9,9 @@ import typer
 
 from ..errors import ParameterError
 from .app import app
-from .common import (AtolOpt, MethodOpt, OutOpt, PlotOpt, PresetOpt, RtolOpt, SetOpt,
+from .common import (AtolOpt, MethodOpt, ModelOpt, OutOpt, PlotOpt, PresetOpt, RtolOpt, SetOpt,
                      TransitionOpt, WorkersOpt, check_outputs, echo_written, load_params,
-                     require_output, save_outputs)
+                     preset_label, require_output, resolve_method, save_outputs)
 
 FromOpt = Annotated[float, typer.Option("--from", help="first value of the range")]
 ToOpt = Annotated[float, typer.Option("--to", help="last value of the range")]
@@ -67,14 +67,15 @@ def _progress(text: str):
 
 @app.command("poincare")
 def poincare_cmd(
-    preset: PresetOpt = "table3",
+    model: ModelOpt = "support",
+    preset: PresetOpt = None,
     set_: SetOpt = None,
     record: Annotated[int, typer.Option("--record", help="section points recorded")] = 2000,
     points: HiddenIntOpt("--points") = None,
     transient: TransientOpt = 500,
     x0: X0Opt = 0.0,
     v0: V0Opt = 0.0,
-    method: MethodOpt = "smooth",
+    method: MethodOpt = None,
     rtol: RtolOpt = 1e-8,
     atol: AtolOpt = 1e-10,
     transition: TransitionOpt = "eq13",
@@ -89,7 +90,9 @@ def poincare_cmd(
 
     if points is not None:  # deprecated name
         record = check_int("points", points, 1)
-    params = load_params(preset, set_)
+    params = load_params(preset, set_, model, "table3")
+    method = resolve_method(params, method)
+    preset = preset_label(params, preset, "table3")
     check_int("record", record, 1)
     check_int("transient", transient, 0)
     require_output(out, plot)
@@ -107,9 +110,12 @@ def poincare_cmd(
 
 @app.command("bifurcation")
 def bifurcation_cmd(
-    preset: PresetOpt = "table3",
+    model: ModelOpt = "support",
+    preset: PresetOpt = None,
     set_: SetOpt = None,
-    param: Annotated[str, typer.Option("--param", help="swept parameter")] = "omega",
+    param: Annotated[Optional[str], typer.Option(
+        "--param", show_default=False,
+        help="swept parameter, one of the model's; default: its forcing frequency (omega)")] = None,
     from_: FromOpt = 0.8,
     to: ToOpt = 1.0,
     steps: StepsOpt = 400,
@@ -118,7 +124,7 @@ def bifurcation_cmd(
     record: Annotated[int, typer.Option("--record", help="section points recorded per value")] = 200,
     x0: X0Opt = 0.0,
     v0: V0Opt = 0.0,
-    method: MethodOpt = "smooth",
+    method: MethodOpt = None,
     rtol: RtolOpt = 1e-8,
     atol: AtolOpt = 1e-10,
     transition: TransitionOpt = "eq13",
@@ -132,8 +138,10 @@ def bifurcation_cmd(
     from ..params import check_param_name
     from ..simulate import check_int
 
-    params = load_params(preset, set_)
-    param = check_param_name(param)
+    params = load_params(preset, set_, model, "table3")
+    method = resolve_method(params, method)
+    preset = preset_label(params, preset, "table3")
+    param = check_param_name(param or params.model.omega, params)
     if sweep not in SWEEPS:
         raise ParameterError(f"sweep: unknown sweep {sweep!r} (known: {', '.join(SWEEPS)})")
     values = value_range(from_, to, steps, f"{param} range")
@@ -157,7 +165,8 @@ def bifurcation_cmd(
 
 @app.command("resonance")
 def resonance_cmd(
-    preset: PresetOpt = "fig6a",
+    model: ModelOpt = "support",
+    preset: PresetOpt = None,
     set_: SetOpt = None,
     from_: FromOpt = 0.5,
     to: ToOpt = 1.6,
@@ -166,7 +175,7 @@ def resonance_cmd(
     record: Annotated[int, typer.Option("--record", help="periods recorded per value")] = 50,
     x0: X0Opt = 0.0,
     v0: V0Opt = 0.0,
-    method: MethodOpt = "smooth",
+    method: MethodOpt = None,
     rtol: RtolOpt = 1e-8,
     atol: AtolOpt = 1e-10,
     transition: TransitionOpt = "eq13",
@@ -181,10 +190,13 @@ def resonance_cmd(
     from ..analysis.resonance import resonance_curve
     from ..simulate import check_int
 
-    params = load_params(preset, set_)
-    omegas = value_range(from_, to, steps, "omega range")
+    params = load_params(preset, set_, model, "fig6a")
+    method = resolve_method(params, method)
+    preset = preset_label(params, preset, "fig6a")
+    w = params.model.omega  # the model's forcing frequency
+    omegas = value_range(from_, to, steps, f"{w} range")
     for v in (omegas[0], omegas[-1]):
-        params.replace(omega=float(v))
+        params.replace(**{w: float(v)})
     check_int("transient", transient, 0)
     check_int("record", record, 1)
     require_output(out, plot)

@@ -8,14 +8,15 @@ from typing import Annotated, Optional
 import typer
 
 from .app import app
-from .common import (AtolOpt, MethodOpt, OutOpt, PlotOpt, PresetOpt, RtolOpt, SetOpt,
+from .common import (AtolOpt, MethodOpt, ModelOpt, OutOpt, PlotOpt, PresetOpt, RtolOpt, SetOpt,
                      TransitionOpt, WorkersOpt, check_outputs, echo_written, load_params,
-                     require_output, save_outputs)
+                     preset_label, require_output, resolve_method, save_outputs)
 
 
 @app.command("basins")
 def basins_cmd(
-    preset: PresetOpt = "fig7",
+    model: ModelOpt = "support",
+    preset: PresetOpt = None,
     set_: SetOpt = None,
     x: Annotated[tuple[float, float], typer.Option("--x", help="range of the initial X: MIN MAX")] = (-3.0, 3.0),
     v: Annotated[tuple[float, float], typer.Option("--v", help="range of the initial V: MIN MAX")] = (-3.0, 3.0),
@@ -24,7 +25,7 @@ def basins_cmd(
     transient: Annotated[int, typer.Option("--transient", help="periods before periodicity is tested")] = 10,
     max_period: Annotated[int, typer.Option("--max-period", help="longest period looked for")] = 16,
     no_early_stop: Annotated[bool, typer.Option("--no-early-stop", help="integrate every point until periodic (slow reference)")] = False,
-    method: MethodOpt = "smooth",
+    method: MethodOpt = None,
     rtol: RtolOpt = 1e-8,
     atol: AtolOpt = 1e-10,
     transition: TransitionOpt = "eq13",
@@ -41,7 +42,9 @@ def basins_cmd(
     from ..io import save_figure
     from ..sweep import Progress
 
-    params = load_params(preset, set_)
+    params = load_params(preset, set_, model, "fig7")
+    method = resolve_method(params, method)
+    preset = preset_label(params, preset, "fig7")
     require_output(out, plot if plot is not None else orbits_plot)
     check_outputs(out, plot, orbits_plot=orbits_plot)
     with Progress("basins") as bar, warnings.catch_warnings(record=True) as caught:

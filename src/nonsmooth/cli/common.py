@@ -13,13 +13,23 @@ import typer
 
 from ..errors import ParameterError
 
-PresetOpt = Annotated[str, typer.Option("--preset", "-p", help="parameter set (see `nonsmooth presets`)")]
+PresetOpt = Annotated[Optional[str], typer.Option(
+    "--preset", "-p", show_default=False,
+    help="parameter set: the paper's (see `nonsmooth presets`) for --model support, else one of "
+         "the model's presets (see `nonsmooth models NAME`); default: the command's paper set "
+         "for support, the model's defaults otherwise")]
+ModelOpt = Annotated[str, typer.Option(
+    "--model", "-m", help="built-in model (see `nonsmooth models`) or path/to/file.py:NAME "
+                          "(a Model defined in your script)")]
 SetOpt = Annotated[Optional[list[str]], typer.Option(
     "--set", "-s", help="override a parameter, NAME=VALUE (repeatable)")]
 OutOpt = Annotated[Optional[Path], typer.Option("--out", "-o", help="netCDF result file")]
 PlotOpt = Annotated[Optional[Path], typer.Option(
     "--plot", help="figure file, format from the suffix: .png, .pdf, .svg, ... (none: PNG)")]
-MethodOpt = Annotated[str, typer.Option("--method", help="smooth (switch model, RKF45) or exact (eta = 0)")]
+MethodOpt = Annotated[Optional[str], typer.Option(
+    "--method", show_default=False,
+    help="smooth (switch model, RKF45) or exact (eta = 0; event-driven); default: smooth, or "
+         "the model's first method if it has no smooth one")]
 RtolOpt = Annotated[float, typer.Option("--rtol", help="relative tolerance")]
 AtolOpt = Annotated[float, typer.Option("--atol", help="absolute tolerance")]
 TransitionOpt = Annotated[str, typer.Option("--transition", help="eq13 (paper, default) or eq12 (convex)")]
@@ -31,11 +41,76 @@ WorkersOpt = Annotated[Optional[int], typer.Option("--workers", "-j", help="thre
 planned: dict[Path, Path] = {}
 
 
-def load_params(preset: str, sets: list[str] | None):
-    """Preset with ``--set`` overrides applied (every error names the field)."""
+def get_model(name: str):
+    """The model ``--model`` names (a built-in name or ``path/to/file.py:NAME``); a one-line
+    ParameterError otherwise."""
+    from ..models import model
+    return model(name)
+
+
+def load_params(preset: str | None, sets: list[str] | None, model: str = "support",
+                default_preset: str | None = None):
+    """The parameters of ``model``: a preset (the paper's for ``support``, where ``None``
+    means ``default_preset``; else one of the model's ``presets``, ``None`` meaning its
+    defaults) with ``--set`` overrides applied. Every error names the field."""
     from ..params import parse_assignments
-    from ..presets import preset as get_preset
-    return get_preset(preset).replace(**parse_assignments(sets))
+
+    m = get_model(model)
+    if m.name == "support" and m.source == "built-in":
+        from ..presets import preset as get_preset
+        base = get_preset(preset or default_preset or "table1")
+        try:
+            values = parse_assignments(sets)
+        except ParameterError as exc:
+            name = str(exc).partition(":")[0]
+            other = [k for k in _models_with(name) if k != "support"]
+            if other and "unknown parameter" in str(exc):
+                raise ParameterError(f"{exc} (a parameter of model {', '.join(other)}: use "
+                                     f"--model {other[0]})") from None
+            raise
+        return base.replace(**values)
+    values = _assignments(sets, m)
+    base = m.preset(preset) if preset is not None else m.params()
+    return base.replace(**values) if values else base
+
+
+def _models_with(name: str) -> list:
+    from ..models.base import _other_models_with
+    return _other_models_with(name)
+
+
+def _assignments(items, m) -> dict:
+    """``--set NAME=VALUE`` items checked against the parameters of model ``m``."""
+    out = {}
+    for item in items or ():
+        if "=" not in item:
+            raise ParameterError(f"--set {item}: expected NAME=VALUE")
+        name, _, value = item.partition("=")
+        name = name.strip()
+        m.param(name)  # one line naming the field (and the model that has it)
+        try:
+            out[name] = float(value)
+        except ValueError:
+            raise ParameterError(f"{name}: expected a number, got {value.strip()!r}") from None
+    return out
+
+
+def preset_label(params, preset: str | None, default_preset: str | None = None) -> str:
+    """What the outputs call the parameter set: the preset (``model/preset`` for a model other
+    than support), or ``model (defaults)``."""
+    name = params.model.name
+    if name == "support":
+        return preset or default_preset or "table1"
+    return f"{name}/{preset}" if preset else f"{name} (defaults)"
+
+
+def resolve_method(params, method: str | None) -> str:
+    """``--method`` or, not given, ``smooth`` where the model has it, else its first method."""
+    methods = params.model.methods
+    if method is None:
+        return "smooth" if "smooth" in methods else next(iter(methods))
+    params.model.method(method)  # one-line error for an unknown method
+    return method
 
 
 def check_outputs(out: Path | None, plot: Path | None, **figures: Path | None) -> None:

@@ -9,9 +9,9 @@ import typer
 from ..errors import ParameterError
 from .app import app
 from .analyses import HiddenIntOpt, _progress
-from .common import (AtolOpt, OutOpt, PlotOpt, PresetOpt, RtolOpt, SetOpt, TransitionOpt,
-                     WorkersOpt, check_outputs, echo_written, load_params, require_output,
-                     save_outputs)
+from .common import (AtolOpt, ModelOpt, OutOpt, PlotOpt, PresetOpt, RtolOpt, SetOpt,
+                     TransitionOpt, WorkersOpt, check_outputs, echo_written, load_params,
+                     preset_label, require_output, save_outputs)
 
 
 def parse_etas(values) -> list[float]:
@@ -40,7 +40,8 @@ def eta_study_cmd(
     eta: Annotated[Optional[list[str]], typer.Option(
         "--eta", "-e", help="band half-width(s) eta to audit, 0 < eta < 0.5: "
                             "--eta 0.28 0.028, --eta 0.28 --eta 0.028 or --eta 0.28,0.028")] = None,
-    preset: PresetOpt = "fig4",
+    model: ModelOpt = "support",
+    preset: PresetOpt = None,
     set_: SetOpt = None,
     transient: Annotated[int, typer.Option(help="forcing periods discarded first")] = 300,
     record: Annotated[int, typer.Option(help="section points (t = kT) compared")] = 200,
@@ -70,7 +71,8 @@ def eta_study_cmd(
     record = points if points is not None else record  # deprecated names
     orbit_periods = portrait_periods if portrait_periods is not None else orbit_periods
     etas = sorted(check_etas(parse_etas(list(eta or []) + list(more or []))), reverse=True)
-    params = load_params(preset, set_)
+    params = load_params(preset, set_, model, "fig4")
+    preset = preset_label(params, preset, "fig4")
     require_output(out, plot)
     check_outputs(out, plot)
     with _progress("eta study") as prog:
@@ -78,11 +80,15 @@ def eta_study_cmd(
                        orbit_periods=orbit_periods, samples_per_period=samples_per_period,
                        x0=x0, v0=v0, rtol=rtol, atol=atol, distance_tol=distance_tol,
                        transition=transition, workers=workers, progress=prog)
+    m = params.model
+    full = "Gamma+" if m.name == "support" else " or ".join(
+        nm for i, nm in enumerate(m.mode_names) if m.contact_modes >> i & 1) or "contact"
+    col = "Gamma+" if m.name == "support" else "contact"
     from ..plot.eta_study import plot_eta_study
     save_outputs(ds, preset, out, plot, plot_eta_study)
     typer.echo(f"{preset}: exact model period {int(ds.exact_period) or 'none'}, "
-               f"{'reaches' if int(ds.exact_reaches_gamma_plus) else 'never reaches'} Gamma+")
-    typer.echo(f"{'eta':>10s} {'Gamma+':>7s} {'period':>7s} {'distance':>10s}  agrees")
+               f"{'reaches' if int(ds.exact_reaches_gamma_plus) else 'never reaches'} {full}")
+    typer.echo(f"{'eta':>10s} {col:>7s} {'period':>7s} {'distance':>10s}  agrees")
     for i, e in enumerate(ds["eta"].values):
         typer.echo(f"{e:10.3g} {int(ds.reaches_gamma_plus[i]):7d} {int(ds.period[i]):7d} "
                    f"{float(ds.distance_to_exact[i]):10.3g}  {'yes' if ds.agrees[i] else 'no'}")

@@ -7,14 +7,15 @@ from typing import Annotated, Optional
 import typer
 
 from .app import app
-from .common import (AtolOpt, MethodOpt, OutOpt, PlotOpt, PresetOpt, RtolOpt, SetOpt,
-                     TransitionOpt, check_outputs, echo_written, load_params, require_output,
-                     save_outputs)
+from .common import (AtolOpt, MethodOpt, ModelOpt, OutOpt, PlotOpt, PresetOpt, RtolOpt, SetOpt,
+                     TransitionOpt, check_outputs, echo_written, load_params, preset_label,
+                     require_output, resolve_method, save_outputs)
 
 
 @app.command("simulate")
 def simulate_cmd(
-    preset: PresetOpt = "table1",
+    model: ModelOpt = "support",
+    preset: PresetOpt = None,
     set_: SetOpt = None,
     periods: Annotated[int, typer.Option(help="recorded forcing periods")] = 10,
     transient: Annotated[int, typer.Option(help="forcing periods discarded first")] = 0,
@@ -23,7 +24,7 @@ def simulate_cmd(
         show_default=False)] = None,
     x0: Annotated[float, typer.Option(help="initial X")] = 0.0,
     v0: Annotated[float, typer.Option(help="initial V")] = 0.0,
-    method: MethodOpt = "smooth",
+    method: MethodOpt = None,
     rtol: RtolOpt = 1e-8,
     atol: AtolOpt = 1e-10,
     transition: TransitionOpt = "eq13",
@@ -33,7 +34,9 @@ def simulate_cmd(
     """Integrate one trajectory; save X, V, region over time (netCDF) and a Fig. 3-style plot."""
     from ..simulate import simulate
 
-    params = load_params(preset, set_)
+    params = load_params(preset, set_, model, "table1")
+    method = resolve_method(params, method)
+    preset = preset_label(params, preset, "table1")
     require_output(out, plot)
     check_outputs(out, plot)
     from ..simulate import mask_names
@@ -45,7 +48,8 @@ def simulate_cmd(
     from ..plot.time_response import plot_time_response
     save_outputs(ds, preset, out, plot, plot_time_response)
     typer.echo(f"{preset}: {periods} periods after {transient}, max X = {float(ds.max_X):.6g}, "
-               f"min X = {float(ds.min_X):.6g}, regions visited: {', '.join(mask_names(ds.regions_visited))}")
+               f"min X = {float(ds.min_X):.6g}, {'regions' if params.model.name == 'support' else 'modes'} visited: "
+               f"{', '.join(mask_names(ds.regions_visited))}")
     echo_written(out, plot)
 
 

@@ -1,19 +1,24 @@
-"""The contract every trajectory kernel implements (smoothed RKF45, exact, later models).
+"""The contract every trajectory kernel implements (the generic kernel of :mod:`.hybrid` for
+any model, and the built-in models' specialised kernels).
 
 A kernel ``advance(p, opts, state, per_period, n_skip, n_out, X, V, R, M, Xmax, Xmin) -> status``
+(the generic one takes the model's compiled functions first: ``advance_generic(fns, p, ...)``)
 integrates from a forcing-period boundary (local time 0) over ``n_skip + n_out`` output
 intervals of length T / ``per_period`` (T = 2 pi / omega); the local time is reset to 0 at every
 period boundary, so the numbers do not depend on how a run is split into calls that each start
 on a period boundary. For output k (0 <= k < n_out), at the end of interval ``n_skip + k``:
 
-* ``X[k], V[k]``  the state;
-* ``R[k]``        the region/mode code at that instant (int8);
-* ``M[k]``        bit mask of the codes visited during the interval (uint8, bit r = code r);
+* ``X[k], V[k]``  the state (u[0], u[1] of the model's state u);
+* ``R[k]``        the mode code at that instant (int8; the model's ``mode_names``);
+* ``M[k]``        bit mask of the modes visited during the interval (uint8, bit r = mode r);
 * ``Xmax[k], Xmin[k]``  the extremes of X over the interval (interior extrema included).
 
-``p`` is ``Params.pack()``; ``opts`` and ``state`` are float64 arrays with the layouts below;
-``state`` is updated in place so that the next call continues the same trajectory. Kernels never
-print or raise: they return a status code from :mod:`nonsmooth.status`.
+``p`` is the model's packed parameters (``params.pack()``, order ``model.param_names``);
+``opts`` and ``state`` are float64 arrays with the layouts below; ``state`` is updated in place
+so that the next call continues the same trajectory (u[2:] and the model's memory live in
+``state[ST_EXTRA:]``). ``fns`` is the tuple of the model's compiled functions with the
+signatures ``MODEL_SIGNATURES`` (see :mod:`nonsmooth.models.base` for their meaning). Kernels
+never print or raise: they return a status code from :mod:`nonsmooth.status`.
 """
 
 # opts layout

@@ -231,6 +231,49 @@ def _store(state, u, n, mem, nmem, mode, h):
         state[ST_EXTRA + n - 2 + i] = mem[i]
 
 
+@nb.njit(cache=True, inline="always")
+def _immediate_exit(G, ng, n, u, f0, C, S, om):
+    """Index of the first guard with g <= 0 and moving out (g' < 0) at the step start, or -1."""
+    for k in range(ng):
+        if _gval(G, k, n, u, C, S) <= 0.0 and _dgval(G, k, n, f0, C, S, om) < 0.0:
+            return k
+    return -1
+
+
+@nb.njit(cache=True, inline="always", fastmath=_FM)
+def _cf_state(MC, mode, om, y0, z0, C, S, hs, u1, f1):
+    """Closed-form state at hs from the homogeneous part (y0, z0) and the forcing phase (C, S):
+    writes (X, V) to u1 and (V, A) to f1; returns (cos, sin) of the forcing at the end."""
+    X1, V1, A1, y1, z1, C1, S1 = eval_state(MC, mode, om, y0, z0, C, S, hs)
+    u1[0] = X1
+    u1[1] = V1
+    f1[0] = V1
+    f1[1] = A1
+    return C1, S1
+
+
+@nb.njit(cache=True, inline="always", fastmath=_FM)
+def _shrink(err2, hs):
+    """Step size after rejecting a step of length hs with squared error norm err2 (not
+    <= 1); returns (h, err2 finite)."""
+    finite = math.isfinite(err2)
+    fac = (max(_FAC_MIN, _SAFETY * _pow_fast(err2, -0.5 * _EXPO))
+           if finite else _FAC_MIN)
+    return hs * fac, finite
+
+
+@nb.njit(cache=True, inline="always", fastmath=_FM)
+def _control(err2, hs, h, last, rejected):
+    """Step-size control after an accepted step of length hs with squared error norm err2;
+    a shortened last step of an output interval does not shrink h. Returns the new h."""
+    fac = _SAFETY * _pow_fast(max(err2, 1e-30), -0.5 * _EXPO)
+    fac = min(_FAC_MAX, max(_FAC_MIN, fac))
+    if rejected:
+        fac = min(fac, 1.0)
+    h_new = hs * fac
+    return max(h, h_new) if last else h_new
+
+
 @nb.njit(GENERIC_KERNEL_SIGNATURE, cache=True, fastmath=_FM)
 def advance_generic(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out, M_out,
                     Xmax_out, Xmin_out):
@@ -316,11 +359,7 @@ def advance_generic(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out
         mask = 1 << mode
         while tau < t_end:
             # ---- immediate exit at the step start: g <= 0 and moving out ----
-            k_tr = -1
-            for k in range(ng):
-                if _gval(G, k, n, u, C, S) <= 0.0 and _dgval(G, k, n, f0, C, S, om) < 0.0:
-                    k_tr = k
-                    break
+            k_tr = _immediate_exit(G, ng, n, u, f0, C, S, om)
             if k_tr < 0:
                 if steps >= max_steps:
                     code = st.MAX_STEPS
@@ -349,10 +388,7 @@ def advance_generic(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out
                     err2, C1, S1 = _rk_step(field, mode, tau, C, S, hs, om, n, u, f0, pp, mem,
                                             rtol, atol, us, k1, k2, k3, k4, k5, u1)
                     if not err2 <= 1.0:
-                        finite = math.isfinite(err2)
-                        fac = (max(_FAC_MIN, _SAFETY * _pow_fast(err2, -0.5 * _EXPO))
-                               if finite else _FAC_MIN)
-                        h = hs * fac
+                        h, finite = _shrink(err2, hs)
                         rejected = True
                         if h < hmin:
                             code = st.STEP_TOO_SMALL if finite else st.NON_FINITE
@@ -444,12 +480,7 @@ def advance_generic(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out
                         hs = s_best * hs
                         last = False
                         if cf:
-                            X1, V1, A1, y1, z1, C1, S1 = eval_state(MC, mode, om, y0, z0, C, S,
-                                                                    hs)
-                            u1[0] = X1
-                            u1[1] = V1
-                            f1[0] = V1
-                            f1[1] = A1
+                            C1, S1 = _cf_state(MC, mode, om, y0, z0, C, S, hs, u1, f1)
                         else:
                             err2, C1, S1 = _rk_step(field, mode, tau, C, S, hs, om, n, u, f0,
                                                     pp, mem, rtol, atol, us, k1, k2, k3, k4, k5,
@@ -460,12 +491,7 @@ def advance_generic(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out
                             break
                 elif not cf:
                     # step-size control after an accepted step without a switch
-                    fac = _SAFETY * _pow_fast(max(err2, 1e-30), -0.5 * _EXPO)
-                    fac = min(_FAC_MAX, max(_FAC_MIN, fac))
-                    if rejected:
-                        fac = min(fac, 1.0)
-                    h_new = hs * fac
-                    h = max(h, h_new) if last else h_new
+                    h = _control(err2, hs, h, last, rejected)
                     rejected = False
                 if cf:
                     xmax, xmin = _x_extrema_exact(MC, mode, om, y0, z0, C, S, u[0], u[1], u1[0],

@@ -76,6 +76,12 @@ def _load_user(path: str, attr: str) -> Model:
     obj = getattr(mod, attr, None)
     if not isinstance(obj, Model):
         raise ParameterError(f"model: {path} defines no Model named {attr!r}")
+    # compile and sample-check every method now: a malformed model fails here, with one
+    # ParameterError naming the problem, before any command computes with it
+    if obj.source == "built-in":
+        object.__setattr__(obj, "source", f"{full}:{attr}")
+    for method in obj.methods:
+        obj.fns(method)
     _USER[key] = obj
     return obj
 

@@ -43,7 +43,9 @@ signatures of :mod:`nonsmooth.integrate.contract`). It declares
 
 * what analyses and plots need: ``contact(params, mask, max_X, min_X)`` (does an orbit with
   this visited-mode mask and these extremes of X count as "in contact", named
-  ``contact_name``), ``lines(params, method)`` (values of X to draw, with labels) and, per
+  ``contact_name``; default: a mode of the bit mask ``contact_modes`` visited),
+  ``contact_level(params)`` (the X at which contact starts, for the contact onset omega_a of
+  ``resonance_curve``; None where it has no meaning), ``lines(params, method)`` (values of X to draw, with labels) and, per
   method, ``flow_is_homeomorphism`` (false where trajectories merge, e.g. in sticking: basins
   then never use the certified early labelling, which assumes an injective map).
 
@@ -241,8 +243,8 @@ class Model:
     contact_modes: int = 0
     contact: Callable | None = None
     contact_name: str = "contact"
+    contact_level: Callable | None = None
     lines: Callable | None = None
-    params_class: type | None = None
     source: str = "built-in"
 
     def __post_init__(self):
@@ -318,8 +320,6 @@ class Model:
 
     def params(self, **values):
         """Validated parameters of this model (defaults for the ones not given)."""
-        if self.params_class is not None:
-            return self.params_class(**self.validate(values))
         return ModelParams(self, **values)
 
     def preset(self, name: str):
@@ -484,4 +484,10 @@ _PARAM_NAMES: dict = {}
 
 
 def _other_models_with(name: str) -> list:
+    import importlib
+    for mod in BUILTIN.values():  # registered as they load
+        try:
+            importlib.import_module(mod)
+        except ImportError:
+            pass
     return [m for m, names in _PARAM_NAMES.items() if name in names]

@@ -238,5 +238,6 @@ MODEL = Model(
     contact_modes=0b110,
     contact_name="the orbit reaches the stop (max X >= 1 - 1e-9)",
     lines=_lines,
+    contact_level=lambda params: 1.0,
 )
 _PARAM_NAMES["impact"] = MODEL.param_names

@@ -484,6 +484,7 @@ MODEL = Model(
     contact_name="contact with a support (a band or contact mode of a side visited and X "
                  "reached that side's gap)",
     lines=_lines,
+    contact_level=lambda params: params.gap_r,  # contact onset on the right support
     presets={"table3": ({**_TABLE3, "eta": 1e-5},
                         "Table 3 supports on both sides, gaps 1, omega = 0.91")},
 )

@@ -10,9 +10,17 @@ from __future__ import annotations
 
 import importlib
 
-#: Region colours used by every figure (codes of the support model, models.support.switch).
-REGION_COLORS = ("#1f77b4", "#ff7f0e", "#2ca02c", "#d62728")
+#: Mode colours, one per mode code (up to models.base.MAX_MODES = 8); the first four are the
+#: region colours of the support model (codes of models.support.switch).
+MODE_COLORS = ("#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564b", "#e377c2",
+               "#17becf")
+REGION_COLORS = MODE_COLORS[:4]
+#: Legend labels of the support model's regions (mathtext); other models use their mode names.
 REGION_LABELS = (r"$\Gamma_-$", r"$\Sigma_\alpha$", r"$\Sigma_\beta$", r"$\Gamma_+$")
+#: Mathtext legend labels of a model's mode codes, by model name (default: ``mode_names``).
+MODE_LABELS = {"support": REGION_LABELS}
+#: Mathtext for the labels of a model's lines (``Model.plot_lines``), by model name.
+LINE_LABELS = {"support": {"support (X = 1)": r"support $X = 1$"}}
 
 #: Plot function -> module of this package that defines it.
 _PLOTS = {
@@ -28,7 +36,8 @@ _PLOTS = {
     "plot_section_panel": ".reproduce_panels",
 }
 
-__all__ = ["REGION_COLORS", "REGION_LABELS", *_PLOTS]
+__all__ = ["MODE_COLORS", "MODE_LABELS", "LINE_LABELS", "REGION_COLORS", "REGION_LABELS",
+           *_PLOTS]
 
 
 def __getattr__(name: str):

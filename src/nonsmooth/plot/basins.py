@@ -10,7 +10,7 @@ from matplotlib.colors import BoundaryNorm, ListedColormap
 from matplotlib.lines import Line2D
 from matplotlib.patches import Patch
 
-from .common import new_figure, param_title
+from .common import draw_model_lines, model_of, new_figure, param_symbol, param_title
 
 #: Basin colours: light for attractors without contact, dark for those with contact (as in the
 #: paper's Fig. 7), cycling through hues when there are several of a kind.
@@ -48,6 +48,17 @@ def _section_points(ds, k):
     V = np.asarray(ds["attractor_V"].values[k], dtype=float)
     keep = np.isfinite(X) & np.isfinite(V)
     return X[keep], V[keep]
+
+
+def _omega_text(ds) -> str:
+    """``, <omega symbol> = value units`` of the model's forcing frequency, or ""."""
+    m = model_of(ds)
+    name = m.omega if m is not None else "omega"
+    omega = ds.attrs.get(f"param_{name}")
+    if omega is None:
+        return ""
+    units = m.param(name).units if m is not None else "rad/s"
+    return f", {param_symbol(m, name)} = {float(omega):.4g} {units}"
 
 
 def plot_basins(ds, ax=None, points: bool = True):
@@ -88,10 +99,7 @@ def plot_basins(ds, ax=None, points: bool = True):
     ax.set_xlabel(r"initial $X_0$")
     ax.set_ylabel(r"initial $V_0 = \dot X_0$")
     ax.legend(handles=handles, loc="upper right", fontsize=8, framealpha=0.85)
-    omega = ds.attrs.get("param_omega")
-    title = "basins of attraction"
-    if omega is not None:
-        title += rf", $\omega$ = {float(omega):.4g} rad/s"
+    title = "basins of attraction" + _omega_text(ds)
     ax.set_title(f"{title}\n{ds.attrs.get('method', '')}: {param_title(ds)}", fontsize=9)
     return fig
 
@@ -99,7 +107,7 @@ def plot_basins(ds, ax=None, points: bool = True):
 def plot_attractors(ds, ax=None):
     """The coexisting attractors in the phase plane (like Fig. 8): each periodic attractor's
     orbit over its whole period (a chaotic one: over a few forcing periods, thinner), its
-    section points, and the support position X = 1."""
+    section points, and the model's lines of X (support: its position X = 1)."""
     if ax is None:
         fig, ax = new_figure(figsize=(6.4, 5.2))
     else:
@@ -118,13 +126,11 @@ def plot_attractors(ds, ax=None):
         ax.scatter(Xs, Vs, s=12 if _chaotic(ds, k) else 55, marker=_MARKERS[k % len(_MARKERS)],
                    facecolor=colors[k],
                    edgecolor="k", lw=1.0, zorder=3)
-    ax.axvline(1.0, color="k", lw=0.8, ls="--", label="support (X = 1)")
+    draw_model_lines(ax, ds, "v", band_edges=False, style=dict(lw=0.8))
     ax.set_xlabel("X = x/g")
     ax.set_ylabel(r"V = $\dot X$")
-    ax.legend(loc="best", fontsize=8)
-    omega = ds.attrs.get("param_omega")
-    title = "coexisting attractors"
-    if omega is not None:
-        title += rf", $\omega$ = {float(omega):.4g} rad/s"
+    if ax.get_legend_handles_labels()[0]:
+        ax.legend(loc="best", fontsize=8)
+    title = "coexisting attractors" + _omega_text(ds)
     ax.set_title(f"{title}\n{ds.attrs.get('method', '')}: {param_title(ds)}", fontsize=9)
     return fig

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .common import new_figure, param_title
+from .common import model_lines, model_of, new_figure, param_symbol, param_title
 
 SWEEP_STYLE = {
     "up": dict(color="#1f77b4", marker=".", label="sweep up"),
@@ -12,8 +12,6 @@ SWEEP_STYLE = {
     "fresh": dict(color="k", marker=".", label="fresh start each value"),
 }
 
-SYMBOLS = {"omega": r"$\omega$", "F0": r"$F_0$", "omega_s": r"$\omega_s$", "xi": r"$\xi$",
-           "xi_s": r"$\xi_s$", "omega0": r"$\omega_0$", "eta": r"$\eta$"}
 
 
 def sweep_names(ds) -> list[str]:
@@ -44,10 +42,11 @@ def plot_bifurcation(ds, var: str = "X"):
                    linewidths=0.4 if marker == "x" else 0, alpha=0.7 if nsw > 1 else 1.0,
                    zorder=3 if str(name) == "up" else 2, rasterized=True, **style)
     if var == "X":
-        ax.axhline(1.0, color="k", lw=0.6, ls="--", label=r"support $X = 1$")
+        draw_lines_over(ax, ds, param, vals)
     failed = int(np.count_nonzero(ds.status.values))
     unit = ds[param].attrs.get("units", "")
-    ax.set_xlabel(f"{SYMBOLS.get(param, param)} [{unit}]" if unit else SYMBOLS.get(param, param))
+    sym = param_symbol(model_of(ds), param)
+    ax.set_xlabel(f"{sym} [{unit}]" if unit else sym)
     ax.set_ylabel(r"$X(kT)$" if var == "X" else r"$\dot X(kT)$")
     ax.set_xlim(vals[0], vals[-1])
     ttl = f"bifurcation diagram, {ds.sizes['n']} section points per value"
@@ -56,10 +55,23 @@ def plot_bifurcation(ds, var: str = "X"):
     ax.set_title(ttl, fontsize=10)
     ax.legend(loc="best", fontsize=8, markerscale=4)
     ax.grid(True, lw=0.3, alpha=0.5)
-    fig.suptitle(f"{ds.attrs.get('method', '')}: {param_title(ds, _others(param))}", fontsize=9)
+    fig.suptitle(f"{ds.attrs.get('method', '')}: {param_title(ds, exclude=(param,))}",
+                 fontsize=9)
     fig.tight_layout()
     return fig
 
 
-def _others(param):
-    return tuple(k for k in ("omega0", "omega_s", "xi", "xi_s", "F0", "omega", "eta") if k != param)
+def draw_lines_over(ax, ds, param, vals, style=None):
+    """The model's main lines of X (``Model.plot_lines`` without band edges) over the swept
+    parameter: horizontal where they do not depend on it, else a curve through the values."""
+    style = {**dict(color="k", lw=0.6, ls="--"), **(style or {})}
+    per_value = [model_lines(ds, band_edges=False, **{param: float(v)}) for v in vals]
+    n = min((len(li) for li in per_value), default=0)
+    for k in range(n):
+        ys = np.array([li[k][0] for li in per_value])
+        lab = per_value[0][k][1]
+        if np.all(ys == ys[0]):
+            ax.axhline(ys[0], label=lab, **style)
+        else:
+            ax.plot(vals, ys, label=lab, **style)
+

@@ -1,10 +1,21 @@
-"""Pieces shared by several figures."""
+"""Pieces shared by several figures.
+
+Every figure reads what it draws about the system from the model named in the dataset
+(:func:`model_of`): the mode colours and legend labels (``Model.mode_names``), the lines of X to
+draw (``Model.plot_lines``), the parameter symbols (``Param.symbol``) and the parameters of the
+title (``Model.param_names``). Files written before the model interface have no ``model``
+attribute: they are the ``support`` model.
+"""
 
 from __future__ import annotations
 
 import numpy as np
 
-from . import REGION_COLORS, REGION_LABELS
+from . import LINE_LABELS, MODE_COLORS, MODE_LABELS
+
+#: Label prefix of the secondary lines of ``Model.plot_lines`` (band edges of the smooth
+#: method), drawn thinner and grey, with one legend entry.
+BAND_EDGE = "band edge"
 
 
 def new_figure(nrows: int = 1, ncols: int = 1, *, figsize=None, **subplots_kw):
@@ -16,18 +27,128 @@ def new_figure(nrows: int = 1, ncols: int = 1, *, figsize=None, **subplots_kw):
     return fig, fig.subplots(nrows, ncols, **subplots_kw)
 
 
-def scatter_by_region(ax, x, y, region, s=2.0, legend=True, **kw):
-    """Scatter (x, y) coloured by region code; only the regions present get a legend entry."""
+# ---- the model of a dataset ------------------------------------------------------------------
+def model_name(ds) -> str:
+    """The model name of a result (``model`` attribute; ``"support"`` when missing)."""
+    attrs = getattr(ds, "attrs", ds)
+    return str(attrs.get("model", "support"))
+
+
+def model_of(ds):
+    """The :class:`~nonsmooth.models.base.Model` named in the dataset (``support`` for files
+    without a ``model`` attribute), or None when it cannot be loaded (e.g. a user model whose
+    file is gone): figures then fall back to generic mode labels and draw no model lines."""
+    from ..errors import ParameterError
+    from ..models import model
+    try:
+        return model(model_name(ds))
+    except ParameterError:
+        return None
+
+
+def mode_colors(m, n=None) -> tuple:
+    """One colour per mode code of model ``m`` (``MODE_COLORS``; the support model keeps the
+    paper's four region colours)."""
+    k = len(m.mode_names) if m is not None else (n or len(MODE_COLORS))
+    return tuple(MODE_COLORS[i % len(MODE_COLORS)] for i in range(k))
+
+
+def mode_labels(m, n=None) -> tuple:
+    """Legend label per mode code of model ``m``: ``MODE_LABELS[name]`` (mathtext; the support
+    model's Gamma-/Sigma labels), else the model's ``mode_names``."""
+    if m is None:
+        return tuple(f"mode {i}" for i in range(n or len(MODE_COLORS)))
+    return tuple(MODE_LABELS.get(m.name, m.mode_names))
+
+
+def param_symbol(m, name: str) -> str:
+    """The plot symbol (mathtext) of parameter ``name`` of model ``m`` (the name if none)."""
+    if m is not None:
+        try:
+            return m.param(name).symbol or name
+        except Exception:  # noqa: BLE001 - not a parameter of this model: show the name
+            pass
+    return name
+
+
+def params_of(ds, **point):
+    """The model's parameters of a result from its ``param_<name>`` attributes (swept ones
+    given in ``point``), or None when they are incomplete or invalid."""
+    m = model_of(ds)
+    if m is None:
+        return None
+    point = {k: float(v) for k, v in point.items() if k in m.param_names}
+    try:
+        return m.params_from_attrs(getattr(ds, "attrs", ds), **point)
+    except Exception:  # noqa: BLE001 - an old or partial file: no params, no lines
+        return None
+
+
+def model_lines(ds, method=None, *, band_edges: bool = True, **point) -> list:
+    """``[(X value, label), ...]`` of the dataset's model (``Model.plot_lines``) at its
+    parameters (``point``: values of swept parameters) for ``method`` (default: the dataset's
+    ``method`` attribute). ``band_edges=False`` leaves out the band-edge lines. Labels are
+    the model's (mathtext where ``LINE_LABELS`` has one)."""
+    m = model_of(ds)
+    if m is None:
+        return []
+    method = method or str(getattr(ds, "attrs", {}).get("method", "smooth"))
+    p = params_of(ds, **point)
+    if p is None:
+        lines = [(1.0, "support (X = 1)")] if m.name == "support" else []
+    else:
+        try:
+            lines = m.plot_lines(p, method)
+        except Exception:  # noqa: BLE001 - a model's lines must not break a figure
+            lines = []
+    tex = LINE_LABELS.get(m.name, {})
+    return [(float(x), tex.get(lab, lab)) for x, lab in lines
+            if band_edges or not str(lab).startswith(BAND_EDGE)]
+
+
+def draw_model_lines(ax, ds, orient: str = "v", *, label: bool = True, band_edges: bool = True,
+                     method=None, style=None, **point) -> list:
+    """Draw the model's lines of X (:func:`model_lines`) on ``ax``: vertical (``orient="v"``,
+    phase planes) or horizontal (``"h"``, X over time or over a parameter). Main lines black
+    dashed (``style`` overrides), band edges thin grey with one legend entry. Returns the
+    lines drawn."""
+    main = dict(color="k", lw=0.6, ls="--")
+    main.update(style or {})
+    draw = ax.axvline if orient == "v" else ax.axhline
+    seen = set()
+    lines = model_lines(ds, method, band_edges=band_edges, **point)
+    for x, lab in lines:
+        band = str(lab).startswith(BAND_EDGE)
+        kw = dict(color="0.3", lw=0.6, ls="--") if band else dict(main)
+        text = "band edges" if band else lab
+        draw(x, label=text if label and text not in seen else None, **kw)
+        seen.add(text)
+    return lines
+
+
+def scatter_by_region(ax, x, y, region, s=2.0, legend=True, model="support", **kw):
+    """Scatter (x, y) coloured by mode (region) code; only the modes present get a legend
+    entry. ``model``: a Model, a model name or a dataset naming one (colours and labels per
+    mode code; default the support model's four regions); None: generic ``mode k`` labels."""
+    if isinstance(model, str):
+        model = model_of({"model": model})
+    elif model is not None and not hasattr(model, "mode_names"):
+        model = model_of(model)
     region = np.asarray(region)
-    for code in range(4):
+    n = int(region.max()) + 1 if region.size else 0
+    colors, labels = mode_colors(model, n), mode_labels(model, n)
+    for code in range(max(len(colors), n)):
         sel = region == code
         if np.any(sel):
-            ax.scatter(np.asarray(x)[sel], np.asarray(y)[sel], s=s, color=REGION_COLORS[code],
-                       label=REGION_LABELS[code] if legend else None, linewidths=0, **kw)
+            ax.scatter(np.asarray(x)[sel], np.asarray(y)[sel], s=s,
+                       color=MODE_COLORS[code % len(MODE_COLORS)],
+                       label=(labels[code] if code < len(labels) else f"mode {code}")
+                       if legend else None, linewidths=0, **kw)
 
 
 def draw_band_edges(ax, eta, omega_s, xi_s, vlim=None, label=True):
-    """Draw h_alpha = +-eta (X = 1 +- eta) and h_beta = +-eta (eq. 7) in the phase plane."""
+    """Support model, smooth method: draw h_alpha = +-eta (X = 1 +- eta) and h_beta = +-eta
+    (eq. 7) in the phase plane."""
     kw = dict(color="0.3", lw=0.6, ls="--")
     ax.axvline(1 - eta, **kw, label=r"band edges ($h=\pm\eta$)" if label else None)
     ax.axvline(1 + eta, **kw)
@@ -40,7 +161,40 @@ def draw_band_edges(ax, eta, omega_s, xi_s, vlim=None, label=True):
         ax.set_ylim(lo, hi)
 
 
-def param_title(ds, keys=("omega0", "omega_s", "xi", "xi_s", "F0", "omega", "eta")) -> str:
+def has_support_bands(ds, method=None) -> bool:
+    """True for the support model's smooth method (the bands h_alpha, h_beta = +-eta)."""
+    method = method or getattr(ds, "attrs", {}).get("method", "smooth")
+    return model_name(ds) == "support" and method == "smooth"
+
+
+def draw_phase_lines(ax, ds, *, label: bool = True, eta=None, vlim=None, **point) -> None:
+    """The model's lines in a phase plane: for the support model's smooth method the band
+    edges h_alpha = +-eta and h_beta = +-eta (:func:`draw_band_edges`), for any other model or
+    method the vertical lines of ``Model.plot_lines`` (labelled if ``label``)."""
+    if has_support_bands(ds):
+        a = ds.attrs
+        eta = float(a["param_eta"]) if eta is None else float(eta)
+        draw_band_edges(ax, eta, float(a.get("param_omega_s", 0.0)),
+                        float(a.get("param_xi_s", 0.0)), vlim=vlim, label=label)
+    else:
+        if eta is not None:
+            point = {"eta": eta, **point}
+        draw_model_lines(ax, ds, "v", label=label, **point)
+
+
+def title_keys(ds, exclude=()) -> tuple:
+    """The parameter names of the dataset's model (in its order), less ``exclude``."""
+    m = model_of(ds)
+    names = m.param_names if m is not None else tuple(
+        k[6:] for k in getattr(ds, "attrs", {}) if k.startswith("param_"))
+    return tuple(k for k in names if k not in exclude)
+
+
+def param_title(ds, keys=None, exclude=()) -> str:
+    """``name=value, ...`` of the parameters in the dataset's attributes; ``keys`` default to
+    the model's parameter names (less ``exclude``)."""
+    if keys is None:
+        keys = title_keys(ds, exclude)
     parts = []
     for k in keys:
         a = f"param_{k}"

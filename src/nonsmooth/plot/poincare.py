@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 
-from .common import new_figure, param_title, scatter_by_region
+from .common import draw_model_lines, model_of, new_figure, param_title, scatter_by_region
 
 
 def _period_text(ds) -> str:
@@ -15,18 +15,19 @@ def _period_text(ds) -> str:
 
 
 def plot_poincare(ds):
-    """Left: phase portrait V(X) over the orbit run (coloured by region) with the section
-    points on it; right: the Poincaré map (all section points, small dots)."""
+    """Left: phase portrait V(X) over the orbit run (coloured by the model's modes) with the
+    section points on it and the model's lines of X (support: X = 1); right: the Poincaré map
+    (all section points, small dots)."""
     fig, (ax0, ax1) = new_figure(1, 2, figsize=(11, 4.6))
     oX, oV, oR = ds.orbit_X.values, ds.orbit_V.values, ds.orbit_region.values
     X, V = ds.X.values, ds.V.values
     ax0.plot(oX, oV, color="0.55", lw=0.6, zorder=1)
-    scatter_by_region(ax0, oX, oV, oR, s=1.5, zorder=2)
+    scatter_by_region(ax0, oX, oV, oR, s=1.5, model=model_of(ds), zorder=2)
     few = X.size <= 64 or int(ds["period"]) > 0
     ax0.scatter(X, V, s=16 if few else 1.0, color="k",
                 marker="o", zorder=3, linewidths=0,
                 label=r"section $t = kT$")
-    ax0.axvline(1.0, color="k", lw=0.6, ls="--")
+    draw_model_lines(ax0, ds, "v", label=False, band_edges=False)
     ax0.set_xlabel(r"$X = x/g$")
     ax0.set_ylabel(r"$V = \dot X$")
     ax0.set_title(f"(a) phase portrait: {_period_text(ds)}", fontsize=10)

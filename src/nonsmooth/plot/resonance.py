@@ -5,15 +5,18 @@ from __future__ import annotations
 import math
 
 
-from .bifurcation import SWEEP_STYLE, _others, sweep_names
-from .common import new_figure, param_title
+from .bifurcation import SWEEP_STYLE, draw_lines_over, sweep_names
+from .common import model_of, new_figure, param_symbol, param_title
 
 
 def plot_resonance(ds, show_min: bool = True):
     """max X (and min X) of the settled response versus omega for the up and the down sweep,
-    with vertical lines at omega_a (contact starts), omega_b and omega_c (jumps)."""
+    with vertical lines at omega_a (contact starts), omega_b and omega_c (jumps) and the
+    model's lines of X (support: X = 1)."""
     fig, ax = new_figure(figsize=(8, 5))
-    w = ds.omega.values
+    m = model_of(ds)
+    wname = m.omega if m is not None and m.omega in ds else "omega"
+    w = ds[wname].values
     for j, name in enumerate(sweep_names(ds)):
         style = dict(SWEEP_STYLE.get(str(name), dict(color="0.3", marker=".", label=str(name))))
         ls = "-" if str(name) == "up" else "--"
@@ -21,7 +24,7 @@ def plot_resonance(ds, show_min: bool = True):
         if show_min:
             style.pop("label")
             ax.plot(w, ds.min_X.values[j], ls=ls, lw=0.8, markersize=2, alpha=0.6, **style)
-    ax.axhline(1.0, color="k", lw=0.6, ls=":", label=r"support $X = 1$")
+    draw_lines_over(ax, ds, wname, w, style=dict(ls=":"))
     for key, sym, col in (("omega_a", r"\omega_a", "#2ca02c"), ("omega_b", r"\omega_b", "#9467bd"),
                           ("omega_c", r"\omega_c", "#8c564b")):
         v = float(ds.attrs.get(key, math.nan))
@@ -31,12 +34,13 @@ def plot_resonance(ds, show_min: bool = True):
                         xytext=(3, 0), textcoords="offset points", rotation=90, va="bottom",
                         fontsize=8, color=col,
                         bbox=dict(boxstyle="round,pad=0.15", fc="white", ec="none", alpha=0.85))
-    ax.set_xlabel(r"$\omega$ [rad/s]")
+    unit = ds[wname].attrs.get("units", "rad/s")
+    ax.set_xlabel(f"{param_symbol(m, wname)} [{unit}]")
     ax.set_ylabel(r"$\max X$, $\min X$" if show_min else r"$\max X$")
     ax.set_xlim(w[0], w[-1])
     ax.set_title("resonance curve (continuation up and down)", fontsize=10)
     ax.legend(loc="upper left", fontsize=8)
     ax.grid(True, lw=0.3, alpha=0.5)
-    fig.suptitle(f"{ds.attrs.get('method', '')}: {param_title(ds, _others('omega'))}", fontsize=9)
+    fig.suptitle(f"{ds.attrs.get('method', '')}: {param_title(ds, exclude=(wname,))}", fontsize=9)
     fig.tight_layout()
     return fig

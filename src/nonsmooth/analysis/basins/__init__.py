@@ -113,7 +113,7 @@ from ...errors import ParameterError
 from ...integrate.contract import N_STATE
 from ...io import check_memory, flag_attrs, provenance_attrs, status_flags
 from ...kernels import Solver, new_state, output_buffers, run
-from ...params import Params
+from ...models.base import ParamsBase
 from ...simulate import check_float, check_int, check_params
 from ...sweep import resolve_workers, threads
 from ..periodicity import section_tolerance
@@ -139,7 +139,7 @@ _CHAOS_ORBIT_PERIODS = 16  # forcing periods of a chaotic attractor's sampled or
 _BYTES_PER_POINT = 112
 
 
-def basins(params: Params, *, x=(-3.0, 3.0), v=(-3.0, 3.0), grid=400, method: str = "smooth",
+def basins(params: ParamsBase, *, x=(-3.0, 3.0), v=(-3.0, 3.0), grid=400, method: str = "smooth",
            transient: int = 10, max_periods: int = 1000, max_period: int = 16, rtol: float = 1e-8,
            atol: float = 1e-10, transition: str = "eq13", early_stop: bool = True,
            samples_per_period: int = 200, workers: int | None = None,

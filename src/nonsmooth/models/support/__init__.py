@@ -85,6 +85,7 @@ MODEL = _SupportModel(
     contact_modes=0b1000,  # Gamma+: full support force (eta_study)
     contact_name="contact with the support (max X >= 1 and a band or Gamma+ visited)",
     lines=_lines,
+    contact_level=lambda params: 1.0,
     presets=PRESETS,
 )
 _PARAM_NAMES["support"] = MODEL.param_names

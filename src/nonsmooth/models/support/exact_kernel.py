@@ -141,6 +141,112 @@ def classify_initial(X, V, w0, ws, xi, xis, F0):
     return FREE
 
 
+@nb.njit(cache=True, inline="always")
+def _tables(w0, ws, xi, xis, F0, om, r, support):
+    """The per-call tables of ``advance_exact``.
+
+    Returns (MC, FN, TB, TL, BD, sw_f, sw_s, sw_n, code): the closed-form coefficients of the
+    two modes (free flight, contact), the functionals (cx, cv, c0) of ``_F_HA``, ``_F_MHB`` and
+    ``_F_V``, the tabulated propagators and piece lengths per level, the derivative-bound
+    coefficients per mode and functional, and the switching functionals watched in each phase
+    (functional, sign, count); code is ``status.RESONANCE`` for a mode forced exactly at its
+    undamped resonance (the tables are then incomplete), else ``status.OK``.
+    """
+    MC = np.empty((2, N_MC))
+    FN = np.zeros((3, 3))
+    TB = np.empty((2, N_LEV, 4))
+    TL = np.empty((2, N_LEV))
+    BD = np.empty((2, 3, N_BD))
+    sw_f = np.empty((3, 2), np.int64)
+    sw_s = np.empty((3, 2))
+    sw_n = np.zeros(3, np.int64)
+    if not mode_coeffs(w0 * w0, xi, 0.0, F0, om, THETA, MC[0]):
+        return MC, FN, TB, TL, BD, sw_f, sw_s, sw_n, st.RESONANCE
+    if not mode_coeffs(w0 * w0 + ws * ws, xi + xis, ws * ws, F0, om, THETA, MC[1]):
+        if support:
+            return MC, FN, TB, TL, BD, sw_f, sw_s, sw_n, st.RESONANCE
+        MC[1, :] = MC[0, :]
+    FN[_F_HA, 0] = 1.0
+    FN[_F_HA, 2] = -1.0
+    FN[_F_MHB, 0] = 1.0
+    FN[_F_MHB, 1] = r
+    FN[_F_MHB, 2] = -1.0
+    FN[_F_V, 1] = 1.0
+    for m in range(2):
+        propagator_table(MC, m, om, N_LEV, TB[m])
+        for lev in range(N_LEV):
+            TL[m, lev] = MC[m, MC_LMAX] * 0.5 ** lev
+    for m in range(2):
+        for f in range(3):
+            functional_bounds(MC[m], om, FN[f, 0], FN[f, 1], BD[m, f])
+    # switching functionals per phase: (functional, sign); count per phase
+    if support:
+        sw_f[_BELOW, 0] = _F_HA
+        sw_s[_BELOW, 0] = 1.0
+        sw_n[_BELOW] = 1
+        sw_f[_ABOVE, 0] = _F_MHB
+        sw_s[_ABOVE, 0] = 1.0
+        sw_f[_ABOVE, 1] = _F_HA
+        sw_s[_ABOVE, 1] = -1.0
+        sw_n[_ABOVE] = 2
+        sw_f[_CONTACT, 0] = _F_MHB
+        sw_s[_CONTACT, 0] = -1.0
+        sw_n[_CONTACT] = 1
+    return MC, FN, TB, TL, BD, sw_f, sw_s, sw_n, st.OK
+
+
+@nb.njit(cache=True, inline="always")
+def _immediate_switch(FN, sw_f, sw_s, nsw, phase, X, V, A):
+    """Index of the first watched functional of ``phase`` that is >= 0 and moving up at the
+    piece start (an immediate switch), or -1."""
+    for q in range(nsw):
+        f = sw_f[phase, q]
+        sg = sw_s[phase, q]
+        g0 = sg * (FN[f, 0] * X + FN[f, 1] * V + FN[f, 2])
+        d0 = sg * (FN[f, 0] * V + FN[f, 1] * A)
+        if g0 >= 0.0 and d0 > 0.0:
+            return q
+    return -1
+
+
+@nb.njit(cache=True, inline="always")
+def _piece_end(MC, TB, TL, mi, lev, om, y, z, C, S, rem):
+    """End of the next piece (tabulated length of level ``lev``, cut at ``rem``, the time
+    left to the output). Returns (last, L, X1, V1, A1, y1, z1, C1, S1): whether it was cut, its
+    length and the closed-form state at its end."""
+    L = TL[mi, lev]
+    if L >= rem:
+        L = rem
+        X1, V1, A1, y1, z1, C1, S1 = eval_state(MC, mi, om, y, z, C, S, L)
+        return True, L, X1, V1, A1, y1, z1, C1, S1
+    X1, V1, A1, y1, z1, C1, S1 = apply_propagator(
+        MC, mi, om, y, z, C, S, TB[mi, lev, 0], TB[mi, lev, 1], TB[mi, lev, 2], TB[mi, lev, 3])
+    return False, L, X1, V1, A1, y1, z1, C1, S1
+
+
+@nb.njit(cache=True, inline="always")
+def _transition(phase, f, X, V):
+    """The phase after the switching functional f of ``phase`` crossed at (X, V)."""
+    if phase == _BELOW:
+        return _CONTACT if V > 0.0 else _ABOVE  # V <= 0: grazing touch
+    if phase == _ABOVE:
+        if f == _F_MHB:
+            return _CONTACT if X > 1.0 else _BELOW
+        return _BELOW
+    return _ABOVE if X > 1.0 else _BELOW
+
+
+@nb.njit(cache=True, inline="always")
+def _period_reset(MC, mi, om, phase, support, X, V, C, S):
+    """Phase and closed-form state (y, z, A) at the start of a forcing period (C = 1, S = 0):
+    a free-flight phase is re-derived from X. Returns (phase, y, z, A)."""
+    if phase != _CONTACT:
+        phase = _ABOVE if (support and X > 1.0) else _BELOW
+    y, z = hom_part(MC, mi, om, X, V, C, S)
+    A = accel(MC, mi, om, y, z, C, S)
+    return phase, y, z, A
+
+
 @nb.njit(KERNEL_SIGNATURE, cache=True)
 def advance_exact(p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out, M_out,
                   Xmax_out, Xmin_out):
@@ -158,46 +264,9 @@ def advance_exact(p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
     V = state[ST_V]
     if not (math.isfinite(X) and math.isfinite(V)):
         return st.NON_FINITE
-    MC = np.empty((2, N_MC))
-    if not mode_coeffs(w0 * w0, xi, 0.0, F0, om, THETA, MC[0]):
-        return st.RESONANCE
-    if not mode_coeffs(w0 * w0 + ws * ws, xi + xis, ws * ws, F0, om, THETA, MC[1]):
-        if support:
-            return st.RESONANCE
-        MC[1, :] = MC[0, :]
-    FN = np.zeros((3, 3))
-    FN[_F_HA, 0] = 1.0
-    FN[_F_HA, 2] = -1.0
-    FN[_F_MHB, 0] = 1.0
-    FN[_F_MHB, 1] = r
-    FN[_F_MHB, 2] = -1.0
-    FN[_F_V, 1] = 1.0
-    TB = np.empty((2, N_LEV, 4))
-    TL = np.empty((2, N_LEV))
-    for m in range(2):
-        propagator_table(MC, m, om, N_LEV, TB[m])
-        for lev in range(N_LEV):
-            TL[m, lev] = MC[m, MC_LMAX] * 0.5 ** lev
-    BD = np.empty((2, 3, N_BD))
-    for m in range(2):
-        for f in range(3):
-            functional_bounds(MC[m], om, FN[f, 0], FN[f, 1], BD[m, f])
-    # switching functionals per phase: (functional, sign); count per phase
-    sw_f = np.empty((3, 2), np.int64)
-    sw_s = np.empty((3, 2))
-    sw_n = np.zeros(3, np.int64)
-    if support:
-        sw_f[_BELOW, 0] = _F_HA
-        sw_s[_BELOW, 0] = 1.0
-        sw_n[_BELOW] = 1
-        sw_f[_ABOVE, 0] = _F_MHB
-        sw_s[_ABOVE, 0] = 1.0
-        sw_f[_ABOVE, 1] = _F_HA
-        sw_s[_ABOVE, 1] = -1.0
-        sw_n[_ABOVE] = 2
-        sw_f[_CONTACT, 0] = _F_MHB
-        sw_s[_CONTACT, 0] = -1.0
-        sw_n[_CONTACT] = 1
+    MC, FN, TB, TL, BD, sw_f, sw_s, sw_n, code = _tables(w0, ws, xi, xis, F0, om, r, support)
+    if code != st.OK:
+        return code
 
     T = 2.0 * math.pi / om
     dt = T / per_period
@@ -244,17 +313,10 @@ def advance_exact(p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
             nsw = sw_n[phase]
             # ---- immediate switch at the piece start (functional at 0 moving up) ----
             s_sw = -1.0
-            k_sw = -1
             last = False
-            for q in range(nsw):
-                f = sw_f[phase, q]
-                sg = sw_s[phase, q]
-                g0 = sg * (FN[f, 0] * X + FN[f, 1] * V + FN[f, 2])
-                d0 = sg * (FN[f, 0] * V + FN[f, 1] * A)
-                if g0 >= 0.0 and d0 > 0.0:
-                    s_sw = 0.0
-                    k_sw = q
-                    break
+            k_sw = _immediate_switch(FN, sw_f, sw_s, nsw, phase, X, V, A)
+            if k_sw >= 0:
+                s_sw = 0.0
             X1 = X
             V1 = V
             A1 = A
@@ -264,17 +326,10 @@ def advance_exact(p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
             S1 = S
             if k_sw < 0:
                 rem = t_end - t
-                L = TL[mi, lev]
                 En = energy_norm(MC, mi, y, z)
                 J0 = -MC[mi, MC_K] * V - MC[mi, MC_C] * A - F0 * om * S
-                if L >= rem:
-                    last = True
-                    L = rem
-                    X1, V1, A1, y1, z1, C1, S1 = eval_state(MC, mi, om, y, z, C, S, L)
-                else:
-                    X1, V1, A1, y1, z1, C1, S1 = apply_propagator(
-                        MC, mi, om, y, z, C, S, TB[mi, lev, 0], TB[mi, lev, 1], TB[mi, lev, 2],
-                        TB[mi, lev, 3])
+                last, L, X1, V1, A1, y1, z1, C1, S1 = _piece_end(MC, TB, TL, mi, lev, om, y, z, C,
+                                                                 S, rem)
                 if not (math.isfinite(X1) and math.isfinite(V1)):
                     code = st.NON_FINITE
                     break
@@ -376,17 +431,7 @@ def advance_exact(p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
             xmin = min(xmin, X)
             if k_sw >= 0:
                 # ---- mode transition ----
-                f = sw_f[phase, k_sw]
-                new_phase = phase
-                if phase == _BELOW:
-                    new_phase = _CONTACT if V > 0.0 else _ABOVE  # V <= 0: grazing touch
-                elif phase == _ABOVE:
-                    if f == _F_MHB:
-                        new_phase = _CONTACT if X > 1.0 else _BELOW
-                    else:
-                        new_phase = _BELOW
-                else:
-                    new_phase = _ABOVE if X > 1.0 else _BELOW
+                new_phase = _transition(phase, sw_f[phase, k_sw], X, V)
                 if t - t_switch < zeno_dt:
                     n_tiny += 1
                     if n_tiny > ZENO_MAX:
@@ -410,10 +455,7 @@ def advance_exact(p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
             t_switch -= T
             C = 1.0
             S = 0.0
-            if phase != _CONTACT:
-                phase = _ABOVE if (support and X > 1.0) else _BELOW
-            y, z = hom_part(MC, mi, om, X, V, C, S)
-            A = accel(MC, mi, om, y, z, C, S)
+            phase, y, z, A = _period_reset(MC, mi, om, phase, support, X, V, C, S)
             lev = 0
         record_interval(it, n_skip, X, V, mode, mask, xmax, xmin, X_out, V_out, R_out, M_out,
                         Xmax_out, Xmin_out)

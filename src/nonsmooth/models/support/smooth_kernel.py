@@ -131,6 +131,121 @@ def _rk_step(mode, X0, V0, A0, Va, C, S, h, om, F0, w02, ws2, xi, xis, eta, r, t
 assert tuple(_C * 8) == (0.0, 2.0, 3.0, 96.0 / 13.0, 8.0, 4.0)
 
 
+@nb.njit(cache=True, inline="always", fastmath=_FM)
+def _error_norm(X, V, X1, V1, eX, eV, rtol, atol):
+    """Squared RMS error norm of a step from (X, V) to (X1, V1) with error estimate (eX, eV);
+    NaN when the step end is not finite."""
+    sx = atol + rtol * max(abs(X), abs(X1))
+    sv = atol + rtol * max(abs(V), abs(V1))
+    err2 = 0.5 * ((eX / sx) ** 2 + (eV / sv) ** 2)  # squared RMS error norm
+    if not (math.isfinite(X1) and math.isfinite(V1)):
+        err2 = np.nan  # an overflow makes sx infinite and err2 zero: never accept it
+    return err2
+
+
+@nb.njit(cache=True, inline="always", fastmath=_FM)
+def _shrink(err2, hs):
+    """Step size after rejecting a step of length hs with squared error norm err2 (not
+    <= 1); returns (h, err2 finite)."""
+    finite = math.isfinite(err2)
+    fac = max(_FAC_MIN, _SAFETY * pow_fast(err2, -0.5 * _EXPO)) if finite else _FAC_MIN
+    return hs * fac, finite
+
+
+@nb.njit(cache=True, inline="always", fastmath=_FM)
+def _detect_exit(mode, X, V, A, X1, V1, A1, hs, eta, r):
+    """Switch detection after an accepted step of length hs in ``mode``: the exit function is
+    checked at the step end and at the interior extrema of h_alpha, V and h_beta on the cubic
+    Hermite interpolant of the step.
+
+    Returns (s_ev, a1, a2, a3, b1, b2, b3): the earliest fraction of the step found outside the
+    region (2.0: none), and the Hermite coefficients of X and V (see ``rkstep._cubic``).
+    """
+    s_ev = 2.0
+    if inside_margin(mode, X1, V1, eta, r) < 0.0:
+        s_ev = 1.0
+    dX = X1 - X
+    a1 = hs * V
+    a2 = 3.0 * dX - 2.0 * hs * V - hs * V1
+    a3 = -2.0 * dX + hs * V + hs * V1
+    dV = V1 - V
+    b1 = hs * A
+    b2 = 3.0 * dV - 2.0 * hs * A - hs * A1
+    b3 = -2.0 * dV + hs * A + hs * A1
+    check = True
+    if mode == GAMMA_MINUS:
+        # leaving Gamma- needs X > 1 - eta; bound the Hermite cubic of X
+        xb = max(X, X1) + (4.0 / 27.0) * hs * (abs(V) + abs(V1))
+        check = xb > 1.0 - eta
+    if check:
+        for which in range(3):
+            if which == 0:  # extrema of h_alpha = X - 1
+                q1, q2 = quad_roots01(a1, 2.0 * a2, 3.0 * a3)
+            elif which == 1:  # extrema of V (h_alpha + h_beta = -r V)
+                q1, q2 = quad_roots01(b1, 2.0 * b2, 3.0 * b3)
+            else:  # extrema of h_beta = -(X - 1) - r V
+                q1, q2 = quad_roots01(-a1 - r * b1, -2.0 * (a2 + r * b2),
+                                       -3.0 * (a3 + r * b3))
+            for q in (q1, q2):
+                if 0.0 < q < s_ev:
+                    if inside_margin(mode, _cubic(X, a1, a2, a3, q),
+                                     _cubic(V, b1, b2, b3, q), eta, r) < 0.0:
+                        s_ev = q
+    return s_ev, a1, a2, a3, b1, b2, b3
+
+
+@nb.njit(cache=True, inline="always", fastmath=_FM)
+def _locate_on_cubic(mode, X, V, a1, a2, a3, b1, b2, b3, s_ev, eta, r):
+    """Illinois iteration on the exit function of ``mode`` along the step's Hermite cubic,
+    between 0 (inside) and s_ev (outside), to 1e-13 of the step.
+
+    Returns (hi, Xi, Vi): the fraction of the step just outside the region and the
+    interpolated state there.
+    """
+    lo = 0.0
+    glo = inside_margin(mode, X, V, eta, r)
+    if glo < 0.0:
+        glo = 0.0
+    hi = s_ev
+    ghi = inside_margin(mode, _cubic(X, a1, a2, a3, hi), _cubic(V, b1, b2, b3, hi), eta, r)
+    side = 0
+    for _ in range(100):
+        if hi - lo <= 1e-13:
+            break
+        den = ghi - glo
+        sm = (lo * ghi - hi * glo) / den if den != 0.0 else 0.5 * (lo + hi)
+        if not (lo < sm < hi):
+            sm = 0.5 * (lo + hi)
+        gm = inside_margin(mode, _cubic(X, a1, a2, a3, sm), _cubic(V, b1, b2, b3, sm), eta, r)
+        if gm < 0.0:
+            hi = sm
+            ghi = gm
+            if side == -1:
+                glo *= 0.5
+            side = -1
+        else:
+            lo = sm
+            glo = gm
+            if side == 1:
+                ghi *= 0.5
+            side = 1
+    Xi = _cubic(X, a1, a2, a3, hi)
+    Vi = _cubic(V, b1, b2, b3, hi)
+    return hi, Xi, Vi
+
+
+@nb.njit(cache=True, inline="always", fastmath=_FM)
+def _control(err2, hs, h, last, rejected):
+    """Step-size control after an accepted step of length hs with squared error norm err2;
+    a shortened last step of an output interval does not shrink h. Returns the new h."""
+    fac = _SAFETY * pow_fast(max(err2, 1e-30), -0.5 * _EXPO)
+    fac = min(_FAC_MAX, max(_FAC_MIN, fac))
+    if rejected:
+        fac = min(fac, 1.0)
+    h_new = hs * fac
+    return max(h, h_new) if last else h_new
+
+
 @nb.njit(KERNEL_SIGNATURE, cache=True, fastmath=_FM)
 def advance_smooth(p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out, M_out,
                    Xmax_out, Xmin_out):
@@ -190,15 +305,9 @@ def advance_smooth(p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_ou
             hs = rem if last else h
             X1, V1, eX, eV, C1, S1 = _rk_step(mode, X, V, A, Va, C, S, hs, om, F0, w02, ws2,
                                                xi, xis, eta, r, tr)
-            sx = atol + rtol * max(abs(X), abs(X1))
-            sv = atol + rtol * max(abs(V), abs(V1))
-            err2 = 0.5 * ((eX / sx) ** 2 + (eV / sv) ** 2)  # squared RMS error norm
-            if not (math.isfinite(X1) and math.isfinite(V1)):
-                err2 = np.nan  # an overflow makes sx infinite and err2 zero: never accept it
+            err2 = _error_norm(X, V, X1, V1, eX, eV, rtol, atol)
             if not err2 <= 1.0:
-                finite = math.isfinite(err2)
-                fac = max(_FAC_MIN, _SAFETY * pow_fast(err2, -0.5 * _EXPO)) if finite else _FAC_MIN
-                h = hs * fac
+                h, finite = _shrink(err2, hs)
                 rejected = True
                 if h < hmin:
                     code = st.STEP_TOO_SMALL if finite else st.NON_FINITE
@@ -208,70 +317,11 @@ def advance_smooth(p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_ou
             A1 = accel(mode, X1, V1, Va, F0 * C1, w02, ws2, xi, xis, eta, r, tr)
 
             # ---- switch detection: step end and interior extrema on the Hermite cubic ----
-            s_ev = 2.0
-            if inside_margin(mode, X1, V1, eta, r) < 0.0:
-                s_ev = 1.0
-            dX = X1 - X
-            a1 = hs * V
-            a2 = 3.0 * dX - 2.0 * hs * V - hs * V1
-            a3 = -2.0 * dX + hs * V + hs * V1
-            dV = V1 - V
-            b1 = hs * A
-            b2 = 3.0 * dV - 2.0 * hs * A - hs * A1
-            b3 = -2.0 * dV + hs * A + hs * A1
-            check = True
-            if mode == GAMMA_MINUS:
-                # leaving Gamma- needs X > 1 - eta; bound the Hermite cubic of X
-                xb = max(X, X1) + (4.0 / 27.0) * hs * (abs(V) + abs(V1))
-                check = xb > 1.0 - eta
-            if check:
-                for which in range(3):
-                    if which == 0:  # extrema of h_alpha = X - 1
-                        q1, q2 = quad_roots01(a1, 2.0 * a2, 3.0 * a3)
-                    elif which == 1:  # extrema of V (h_alpha + h_beta = -r V)
-                        q1, q2 = quad_roots01(b1, 2.0 * b2, 3.0 * b3)
-                    else:  # extrema of h_beta = -(X - 1) - r V
-                        q1, q2 = quad_roots01(-a1 - r * b1, -2.0 * (a2 + r * b2),
-                                               -3.0 * (a3 + r * b3))
-                    for q in (q1, q2):
-                        if 0.0 < q < s_ev:
-                            if inside_margin(mode, _cubic(X, a1, a2, a3, q),
-                                             _cubic(V, b1, b2, b3, q), eta, r) < 0.0:
-                                s_ev = q
+            s_ev, a1, a2, a3, b1, b2, b3 = _detect_exit(mode, X, V, A, X1, V1, A1, hs, eta, r)
             event = s_ev <= 1.0
             if event:
-                # Illinois on the exit function along the interpolant: lo inside, hi outside
-                lo = 0.0
-                glo = inside_margin(mode, X, V, eta, r)
-                if glo < 0.0:
-                    glo = 0.0
-                hi = s_ev
-                ghi = inside_margin(mode, _cubic(X, a1, a2, a3, hi), _cubic(V, b1, b2, b3, hi),
-                                    eta, r)
-                side = 0
-                for _ in range(100):
-                    if hi - lo <= 1e-13:
-                        break
-                    den = ghi - glo
-                    sm = (lo * ghi - hi * glo) / den if den != 0.0 else 0.5 * (lo + hi)
-                    if not (lo < sm < hi):
-                        sm = 0.5 * (lo + hi)
-                    gm = inside_margin(mode, _cubic(X, a1, a2, a3, sm), _cubic(V, b1, b2, b3, sm),
-                                       eta, r)
-                    if gm < 0.0:
-                        hi = sm
-                        ghi = gm
-                        if side == -1:
-                            glo *= 0.5
-                        side = -1
-                    else:
-                        lo = sm
-                        glo = gm
-                        if side == 1:
-                            ghi *= 0.5
-                        side = 1
-                Xi = _cubic(X, a1, a2, a3, hi)
-                Vi = _cubic(V, b1, b2, b3, hi)
+                # locate the exit on the interpolant: lo inside, hi outside
+                hi, Xi, Vi = _locate_on_cubic(mode, X, V, a1, a2, a3, b1, b2, b3, s_ev, eta, r)
                 if hi < 1.0:
                     hs = hi * hs
                     X1, V1, eX, eV, C1, S1 = _rk_step(mode, X, V, A, Va, C, S, hs, om, F0, w02,
@@ -289,13 +339,7 @@ def advance_smooth(p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_ou
                 mask |= 1 << mode
             else:
                 xmax, xmin = _x_extrema(X, V, X1, V1, hs, xmax, xmin)
-                # step-size control after an accepted step
-                fac = _SAFETY * pow_fast(max(err2, 1e-30), -0.5 * _EXPO)
-                fac = min(_FAC_MAX, max(_FAC_MIN, fac))
-                if rejected:
-                    fac = min(fac, 1.0)
-                h_new = hs * fac
-                h = max(h, h_new) if last else h_new
+                h = _control(err2, hs, h, last, rejected)
                 rejected = False
             X = X1
             V = V1

@@ -1,0 +1,114 @@
+"""Figures read the model named in the dataset: mode colours and labels, lines of X, parameter
+symbols and title parameters (support keeps the paper's labels and its X = 1 line)."""
+
+import numpy as np
+import pytest
+from matplotlib.figure import Figure
+
+import nonsmooth as ns
+from nonsmooth.analysis.bifurcation import bifurcation_diagram
+from nonsmooth.analysis.poincare import poincare
+from nonsmooth.plot import REGION_LABELS
+from nonsmooth.plot.bifurcation import plot_bifurcation
+from nonsmooth.plot.common import mode_labels, model_lines, model_of, param_title
+from nonsmooth.plot.poincare import plot_poincare
+from nonsmooth.plot.time_response import plot_time_response
+
+MODELS = {
+    "stick_slip": lambda: ns.model("stick_slip").params(),  # default stick-slip cycle
+    "support": lambda: ns.preset("table3"),
+}
+CASES = [(m, k) for m in MODELS for k in ("smooth", "exact")]
+
+
+@pytest.fixture(scope="module")
+def results():
+    out = {}
+    for name, make in MODELS.items():
+        p = make()
+        for method in ("smooth", "exact"):
+            out[name, method] = dict(
+                simulate=ns.simulate(p, periods=3, method=method, samples_per_period=50),
+                poincare=poincare(p, record=3, transient=3, method=method, orbit_samples=50,
+                                  orbit_periods=3),
+                bifurcation=bifurcation_diagram(p, "omega", [0.85, 0.9, 0.95], method=method,
+                                                transient=2, record=3, settle=False,
+                                                sweep="up"),
+            )
+    return out
+
+
+def _legend_texts(fig):
+    return [t.get_text() for ax in fig.axes if ax.get_legend() is not None
+            for t in ax.get_legend().get_texts()]
+
+
+def _vlines_at(ax, x):
+    return [ln for ln in ax.lines if np.allclose(ln.get_xdata(), x)]
+
+
+def _hlines_at(ax, y):
+    return [ln for ln in ax.lines if np.allclose(ln.get_ydata(), y)]
+
+
+def _labels_of(name):
+    return REGION_LABELS if name == "support" else ns.model(name).mode_names
+
+
+@pytest.mark.parametrize("name,method", CASES)
+def test_time_response_uses_the_model(results, name, method):
+    ds = results[name, method]["simulate"]
+    assert ds.attrs["model"] == name
+    fig = plot_time_response(ds)
+    assert isinstance(fig, Figure)
+    texts = _legend_texts(fig)
+    labels = _labels_of(name)
+    visited = sorted(set(np.asarray(ds.region.values).tolist()))
+    assert all(labels[c] in texts for c in visited)
+    other = set(REGION_LABELS) if name != "support" else set(ns.model("stick_slip").mode_names)
+    assert not other & set(texts)
+    if name == "support":
+        assert _hlines_at(fig.axes[0], 1.0)  # X = 1 on the time response
+
+
+@pytest.mark.parametrize("name,method", CASES)
+def test_poincare_uses_the_model(results, name, method):
+    ds = results[name, method]["poincare"]
+    fig = plot_poincare(ds)
+    assert isinstance(fig, Figure)
+    texts = _legend_texts(fig)
+    labels = _labels_of(name)
+    visited = sorted(set(np.asarray(ds.orbit_region.values).tolist()))
+    assert all(labels[c] in texts for c in visited)
+    assert bool(_vlines_at(fig.axes[0], 1.0)) == (name == "support")
+    params = ", ".join(f"{k}=" for k in ns.model(name).param_names)
+    assert all(k in fig._suptitle.get_text() for k in params.split(", "))
+
+
+@pytest.mark.parametrize("name,method", CASES)
+def test_bifurcation_uses_the_model(results, name, method):
+    ds = results[name, method]["bifurcation"]
+    fig = plot_bifurcation(ds)
+    assert isinstance(fig, Figure)
+    ax = fig.axes[0]
+    assert ns.model(name).param("omega").symbol in ax.get_xlabel()
+    texts = _legend_texts(fig)
+    if name == "support":
+        assert _hlines_at(ax, 1.0) and r"support $X = 1$" in texts
+    else:
+        assert not _hlines_at(ax, 1.0)
+        assert "v_belt=" in fig._suptitle.get_text() and "omega=" not in fig._suptitle.get_text()
+
+
+def test_model_helpers():
+    assert model_of({}).name == "support"  # files written before the model attribute
+    assert mode_labels(ns.model("support")) == REGION_LABELS
+    assert mode_labels(ns.model("stick_slip")) == ns.model("stick_slip").mode_names
+    p = ns.model("stick_slip").params()
+    attrs = p.attrs()
+    assert model_lines(attrs, "exact") == []
+    assert "v_belt=0.2" in param_title(type("D", (), {"attrs": attrs})())
+    sup = ns.preset("table3").attrs()
+    assert model_lines(sup, "exact") == [(1.0, r"support $X = 1$")]
+    assert len(model_lines(sup, "smooth")) == 3
+    assert model_lines(sup, "smooth", band_edges=False) == [(1.0, r"support $X = 1$")]
