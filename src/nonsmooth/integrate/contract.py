@@ -88,10 +88,43 @@ def _model_signatures():
     return sigs, t.Tuple(tuple(t.FunctionType(s) for s in sigs))
 
 
+class ModelFns(tuple):
+    """A model's compiled functions (the ``fns`` tuple of the generic kernel). numba types it
+    by a direct lookup (``MODEL_FNS_TYPE``) instead of typing each first-class function on
+    every call from Python (~60 us per call), and unboxes each element from its cached
+    address (:class:`CompiledFunction`)."""
+
+    __slots__ = ()
+
+
+class CompiledFunction:
+    """A compiled ``cfunc`` with its machine-code address looked up once (numba's wrapper
+    address protocol): numba would otherwise ask LLVM for the address of every function on
+    every call from Python."""
+
+    __slots__ = ("cfunc", "address")
+
+    def __init__(self, cfunc):
+        self.cfunc = cfunc
+        self.address = cfunc.address
+
+    def __wrapper_address__(self, sig=None):
+        return self.address
+
+
+def _register_typeof():
+    from numba.extending import typeof_impl
+
+    @typeof_impl.register(ModelFns)
+    def _typeof_model_fns(val, c):
+        return MODEL_FNS_TYPE
+
+
 #: numba signatures of a model's compiled functions (see ``nonsmooth.models.base``), in the
 #: order of the tuple ``fns`` that the generic kernel receives, and the type of that tuple.
 MODEL_SIGNATURES, MODEL_FNS_TYPE = _model_signatures()
 FIELD_SIG, JACOBIAN_SIG, GUARDS_SIG, TRANSITION_SIG, INITIAL_SIG, LINEAR_SIG = MODEL_SIGNATURES
+_register_typeof()
 
 
 def _signatures():

@@ -396,7 +396,7 @@ def compile_method(model: Model, method: str) -> tuple:
     otherwise."""
     import numba as nb
 
-    from ..integrate.contract import MAX_GUARDS, MODEL_SIGNATURES
+    from ..integrate.contract import MAX_GUARDS, MODEL_SIGNATURES, CompiledFunction, ModelFns
     m = model.method(method)
     parts = ("field", "jacobian", "guards", "transition", "initial", "linear")
     fns = []
@@ -410,7 +410,7 @@ def compile_method(model: Model, method: str) -> tuple:
                 raise ParameterError(f"model {model.name}: {method}.{part} "
                                      f"({getattr(fn, '__name__', part)}) does not compile with "
                                      f"numba: {_numba_reason(exc)}") from None
-    fns = tuple(fns)
+    fns = ModelFns(CompiledFunction(f) for f in fns)
     _sample_check(model, method, m, fns, MAX_GUARDS)
     return fns
 

@@ -359,7 +359,7 @@ def _sample_orbits(found, solver, pk, spp):
     for pts, kind in zip(found.points, found.kind):
         nout = (len(pts) if kind == KIND_PERIODIC else _CHAOS_ORBIT_PERIODS) * spp
         X, V, R, M, XM, Xm = output_buffers(nout)
-        if run(solver.code, solver.fns, pk, solver.opts(), new_state(pts[0, 0], pts[0, 1]), spp, 0, nout,
+        if solver.advance(pk, solver.opts(), new_state(pts[0, 0], pts[0, 1]), spp, 0, nout,
                    X, V, R, M, XM, Xm) != 0:
             X[:] = np.nan
             V[:] = np.nan

@@ -7,7 +7,7 @@ from __future__ import annotations
 import numpy as np
 
 from ...integrate.contract import ST_X
-from ...kernels import new_state, output_buffers, run
+from ...kernels import new_state, output_buffers
 from ..periodicity import detect_period
 from ._core import N_CONFIRM
 
@@ -178,7 +178,7 @@ def _polish(solver, pk, pts, tol):
     last = pts[-1].copy()
     for it in range(max(1, _POLISH_MAX // q)):
         prev = np.stack([X, V], axis=1) if it else pts
-        if run(solver.code, solver.fns, pk, opts, state, 1, 0, q, X, V, R, M, XM, Xm) != 0:
+        if solver.advance(pk, opts, state, 1, 0, q, X, V, R, M, XM, Xm) != 0:
             return None
         if not (np.isfinite(X).all() and np.isfinite(V).all()):
             return None
@@ -193,7 +193,7 @@ def _polish(solver, pk, pts, tol):
     out = np.stack([X[:d], V[:d]], axis=1), _extremes(XM[:d], Xm[:d], M[:d])
     W = X.copy(), V.copy()
     for _ in range(max(_CONFIRM_MULT, -(-_CONFIRM_MIN // q))):
-        if run(solver.code, solver.fns, pk, opts, state, 1, 0, q, X, V, R, M, XM, Xm) != 0:
+        if solver.advance(pk, opts, state, 1, 0, q, X, V, R, M, XM, Xm) != 0:
             return None
         if not ((np.abs(X - W[0]) <= tol).all() and (np.abs(V - W[1]) <= tol).all()):
             return None
@@ -216,7 +216,7 @@ def _confirm_chaos(solver, pk, state, tol, max_period, scale):
         s = state.copy()
         s[ST_X] += dx
         X, V, R, M, XM, Xm = output_buffers(_CHAOS_PERIODS)
-        if run(solver.code, solver.fns, pk, solver.opts(), s, 1, 0, _CHAOS_PERIODS, X, V, R, M, XM,
+        if solver.advance(pk, solver.opts(), s, 1, 0, _CHAOS_PERIODS, X, V, R, M, XM,
                    Xm) != 0 or not (np.isfinite(X).all() and np.isfinite(V).all()):
             return None
         runs.append((X, V, XM, Xm, M))
