@@ -304,9 +304,9 @@ def exact_linear(mode, p, out):
         return 0
     k = p[_W0] * p[_W0]
     d = k - p[_OM] * p[_OM]
-    if not d * d + (p[_XI] * p[_OM]) ** 2 > 1e-300:
-        # undamped and omega = omega0: no bounded closed form in the kernel (even for F0 = 0,
-        # the defaults): integrate this mode by the tight-tolerance RKF45 instead
+    if p[_F0] != 0.0 and not d * d + (p[_XI] * p[_OM]) ** 2 > 1e-300:
+        # undamped and forced at omega = omega0: no bounded closed form (secular growth);
+        # integrate this mode by the tight-tolerance RKF45 instead
         return 0
     out[0] = k
     out[1] = p[_XI]
