@@ -57,7 +57,7 @@ CASES = (
     ("impact", lambda m: m.params(F0=0.5, omega=0.8, r=0.8),
      "F0 = 0.5, omega = 0.8, r = 0.8: impacts every period"),
     ("stick_slip", lambda m: m.params(),
-     "defaults: unforced stick-slip cycle (omega = omega0: exact slip by RKF45 1e-12)"),
+     "defaults: unforced stick-slip cycle (omega = omega0)"),
     ("stick_slip", lambda m: m.params(omega=0.95),
      "defaults, omega = 0.95: stick-slip cycle, Coulomb slip in closed form"),
 )
