@@ -64,8 +64,7 @@ from .contract import (  # noqa: E402
 from .pwlinear import MC_LMAX, N_MC, accel, eval_state, hom_part, mode_coeffs  # noqa: E402
 from .record import record_interval  # noqa: E402
 from .roots import quad_roots01  # noqa: E402
-from .rkstep import _A, _B, _C, _E, _EXPO, _FAC_MAX, _FAC_MIN, _FM, _SAFETY, _cubic, _x_extrema  # noqa: E402
-from .rkstep import pow_fast as _pow_fast  # noqa: E402
+from .rkstep import _A, _B, _C, _E, _FM, _control, _cubic, _shrink, _x_extrema  # noqa: E402
 from .trig import cos_sin_small  # noqa: E402
 
 MAX_MODES = 8  # mode codes 0..7 (bit mask M is uint8)
@@ -250,28 +249,6 @@ def _cf_state(MC, mode, om, y0, z0, C, S, hs, u1, f1):
     f1[0] = V1
     f1[1] = A1
     return C1, S1
-
-
-@nb.njit(cache=True, inline="always", fastmath=_FM)
-def _shrink(err2, hs):
-    """Step size after rejecting a step of length hs with squared error norm err2 (not
-    <= 1); returns (h, err2 finite)."""
-    finite = math.isfinite(err2)
-    fac = (max(_FAC_MIN, _SAFETY * _pow_fast(err2, -0.5 * _EXPO))
-           if finite else _FAC_MIN)
-    return hs * fac, finite
-
-
-@nb.njit(cache=True, inline="always", fastmath=_FM)
-def _control(err2, hs, h, last, rejected):
-    """Step-size control after an accepted step of length hs with squared error norm err2;
-    a shortened last step of an output interval does not shrink h. Returns the new h."""
-    fac = _SAFETY * _pow_fast(max(err2, 1e-30), -0.5 * _EXPO)
-    fac = min(_FAC_MAX, max(_FAC_MIN, fac))
-    if rejected:
-        fac = min(fac, 1.0)
-    h_new = hs * fac
-    return max(h, h_new) if last else h_new
 
 
 @nb.njit(GENERIC_KERNEL_SIGNATURE, cache=True, fastmath=_FM)

@@ -61,3 +61,24 @@ def _x_extrema(X, V, X1, V1, h, xmax, xmin):
                 xmax = max(xmax, xq)
                 xmin = min(xmin, xq)
     return xmax, xmin
+
+
+@nb.njit(cache=True, inline="always", fastmath=_FM)
+def _shrink(err2, hs):
+    """Step size after rejecting a step of length hs with squared error norm err2 (not
+    <= 1); returns (h, err2 finite)."""
+    finite = math.isfinite(err2)
+    fac = max(_FAC_MIN, _SAFETY * pow_fast(err2, -0.5 * _EXPO)) if finite else _FAC_MIN
+    return hs * fac, finite
+
+
+@nb.njit(cache=True, inline="always", fastmath=_FM)
+def _control(err2, hs, h, last, rejected):
+    """Step-size control after an accepted step of length hs with squared error norm err2;
+    a shortened last step of an output interval does not shrink h. Returns the new h."""
+    fac = _SAFETY * pow_fast(max(err2, 1e-30), -0.5 * _EXPO)
+    fac = min(_FAC_MAX, max(_FAC_MIN, fac))
+    if rejected:
+        fac = min(fac, 1.0)
+    h_new = hs * fac
+    return max(h, h_new) if last else h_new

@@ -32,6 +32,7 @@ import math
 import numba as nb
 
 from .base import Method, Model, Param, _PARAM_NAMES, param_index
+from .oscillator import forced_row as _row
 
 PARAMETERS = (
     Param("omega0", 1.0, low=0.0, low_open=True, units="rad/s",
@@ -58,15 +59,6 @@ STUCK = 2
 V_STICK = 1e-9
 #: a chatter sequence that would accumulate within CHATTER_T forcing periods sticks at once
 CHATTER_T = 1e-6
-
-
-@nb.njit(cache=True, inline="always")
-def _row(G, k, a, b, c, d):
-    G[k, 0] = a
-    G[k, 1] = b
-    G[k, 2] = c
-    G[k, 3] = d
-    G[k, 4] = 0.0
 
 
 @nb.njit(cache=True, inline="always")

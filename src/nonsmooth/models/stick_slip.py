@@ -60,6 +60,7 @@ import numba as nb
 
 from ..errors import ParameterError
 from .base import Method, Model, Param, _PARAM_NAMES, param_index
+from .oscillator import forced_row as _row
 
 PARAMETERS = (
     Param("omega0", 1.0, low=0.0, low_open=True, units="rad/s",
@@ -99,15 +100,6 @@ _EXP_CAP = 700.0  # exp argument cap (the slip field extended far past its borde
 
 
 # ---- helpers (inlined into the cfuncs) --------------------------------------------------------
-@nb.njit(cache=True, inline="always")
-def _row(G, k, a, b, c, dc):
-    G[k, 0] = a
-    G[k, 1] = b
-    G[k, 2] = c
-    G[k, 3] = dc
-    G[k, 4] = 0.0
-
-
 @nb.njit(cache=True, inline="always")
 def _slip_friction(sg, vrel, p):
     """(f, df/dV) in slip direction sg (+1 forward, -1 backward), smooth in vrel across

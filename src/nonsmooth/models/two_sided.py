@@ -32,6 +32,7 @@ import numba as nb
 
 from ..errors import ParameterError
 from .base import Method, Model, Param, _PARAM_NAMES, param_index
+from .oscillator import row as _row
 
 PARAMETERS = (
     Param("omega0", 1.0, low=0.0, low_open=True, units="rad/s",
@@ -75,15 +76,6 @@ _VA_R, _SEL_R, _VA_L, _SEL_L = 0, 1, 2, 3
 
 
 # ---- helpers --------------------------------------------------------------------------------
-@nb.njit(cache=True, inline="always")
-def _row(G, k, a, b, c):
-    G[k, 0] = a
-    G[k, 1] = b
-    G[k, 2] = c
-    G[k, 3] = 0.0
-    G[k, 4] = 0.0
-
-
 @nb.njit(cache=True, inline="always")
 def _ratio(w, x):
     """xi/omega^2 of h_beta; 0 for a support without stiffness."""

@@ -16,21 +16,13 @@ import numba as nb
 
 from ...params import IDX
 from .switch import GAMMA_MINUS, GAMMA_PLUS, SIGMA_ALPHA, SIGMA_BETA, beta_ratio, region
+from ..oscillator import row as _row
 
 N_MEMORY = 2
 _W0, _WS, _XI, _XIS, _F0, _ETA = (IDX[k] for k in ("omega0", "omega_s", "xi", "xi_s", "F0",
                                                    "eta"))
 _FREE = 0
 _CONTACT = 3
-
-
-@nb.njit(cache=True, inline="always")
-def _row(G, k, a, b, c):
-    G[k, 0] = a
-    G[k, 1] = b
-    G[k, 2] = c
-    G[k, 3] = 0.0
-    G[k, 4] = 0.0
 
 
 # ---- smooth (switch model, eq. 13) ----------------------------------------------------------

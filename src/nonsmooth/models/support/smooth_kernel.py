@@ -48,19 +48,16 @@ from ...integrate.contract import (
 )
 from ...integrate.record import record_interval, store_state
 from ...integrate.rkstep import (
+    _control,
+    _shrink,
     _A,
     _B,
     _C,
     _E,
-    _EXPO,
-    _FAC_MAX,
-    _FAC_MIN,
     _FM,
-    _SAFETY,
     RKF45_ORDER,
     _cubic,
     _x_extrema,
-    pow_fast,
 )
 from ...integrate.roots import quad_roots01
 from ...integrate.trig import cos_sin_small
@@ -144,15 +141,6 @@ def _error_norm(X, V, X1, V1, eX, eV, rtol, atol):
 
 
 @nb.njit(cache=True, inline="always", fastmath=_FM)
-def _shrink(err2, hs):
-    """Step size after rejecting a step of length hs with squared error norm err2 (not
-    <= 1); returns (h, err2 finite)."""
-    finite = math.isfinite(err2)
-    fac = max(_FAC_MIN, _SAFETY * pow_fast(err2, -0.5 * _EXPO)) if finite else _FAC_MIN
-    return hs * fac, finite
-
-
-@nb.njit(cache=True, inline="always", fastmath=_FM)
 def _detect_exit(mode, X, V, A, X1, V1, A1, hs, eta, r):
     """Switch detection after an accepted step of length hs in ``mode``: the exit function is
     checked at the step end and at the interior extrema of h_alpha, V and h_beta on the cubic
@@ -232,18 +220,6 @@ def _locate_on_cubic(mode, X, V, a1, a2, a3, b1, b2, b3, s_ev, eta, r):
     Xi = _cubic(X, a1, a2, a3, hi)
     Vi = _cubic(V, b1, b2, b3, hi)
     return hi, Xi, Vi
-
-
-@nb.njit(cache=True, inline="always", fastmath=_FM)
-def _control(err2, hs, h, last, rejected):
-    """Step-size control after an accepted step of length hs with squared error norm err2;
-    a shortened last step of an output interval does not shrink h. Returns the new h."""
-    fac = _SAFETY * pow_fast(max(err2, 1e-30), -0.5 * _EXPO)
-    fac = min(_FAC_MAX, max(_FAC_MIN, fac))
-    if rejected:
-        fac = min(fac, 1.0)
-    h_new = hs * fac
-    return max(h, h_new) if last else h_new
 
 
 @nb.njit(KERNEL_SIGNATURE, cache=True, fastmath=_FM)
