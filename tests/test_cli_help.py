@@ -9,7 +9,7 @@ from typer.testing import CliRunner
 from nonsmooth.cli import app
 
 COMMANDS = ["simulate", "presets", "poincare", "bifurcation", "resonance", "basins", "eta-study",
-            "reproduce"]
+            "reproduce", "lyapunov", "orbit"]
 
 
 @pytest.mark.parametrize("command", COMMANDS)

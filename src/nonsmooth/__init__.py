@@ -29,6 +29,8 @@ _LAZY = {
     "resonance_curve": ".analysis.resonance",
     "basins": ".analysis.basins",
     "eta_study": ".analysis.eta_study",
+    "lyapunov": ".analysis.stability",
+    "periodic_orbit": ".analysis.stability",
     "reproduce": ".reproduction",
 }
 
@@ -37,7 +39,7 @@ _SUBMODULES = ("analysis", "cli", "errors", "integrate", "io", "kernels", "model
                "plot", "presets", "reproduction", "status", "sweep")
 
 __all__ = ["__version__", "Params", "PARAM_NAMES", "model", "models", "preset", "PRESETS", "simulate", "reproduce", "Solver",
-           "eta_study", "poincare", "bifurcation_diagram", "resonance_curve", "basins",
+           "eta_study", "lyapunov", "periodic_orbit", "poincare", "bifurcation_diagram", "resonance_curve", "basins",
            "NonsmoothError", "ParameterError", "OutputError", "IntegrationError"]
 
 

@@ -290,7 +290,7 @@ def bifurcation_diagram(params: ParamsBase, param: str, values, *, sweep: str = 
                         x0: float = 0.0, v0: float = 0.0, rtol: float = 1e-8,
                         atol: float = 1e-10, transition: str = "eq13", settle: bool = True,
                         max_steps: int = 200_000, workers: int | None = None,
-                        progress=None) -> xr.Dataset:
+                        progress=None, lyapunov: bool | None = None) -> xr.Dataset:
     """Orbit diagram of the stroboscopic section over ``param`` (any of omega, F0, omega_s,
     xi, xi_s, omega0, eta) at ``values`` (sorted ascending; each validated by Params).
 
@@ -310,6 +310,9 @@ def bifurcation_diagram(params: ParamsBase, param: str, values, *, sweep: str = 
     ``transient_used`` (periods before the recorded window). The swept parameter is not in
     the attrs (``param_<param>`` is dropped).
     ``max_steps``: integration steps allowed per forcing period (see ``kernels.Solver``).
+    ``lyapunov`` (None = where tangent dynamics exist, i.e. not for eq. 12): also ``lambda1`` with ``lambda1_stderr`` (over ``record`` further periods
+    of each point's attractor) and the verdict ``motion`` (periodic / quasi-periodic /
+    chaotic / not settled; see ``analysis.stability.classify``).
     """
     from ..simulate import check_float, check_int, check_params
     params = check_params(params)
@@ -332,7 +335,8 @@ def bifurcation_diagram(params: ParamsBase, param: str, values, *, sweep: str = 
                        workers=workers, progress=progress)
     return branches_dataset(params, param, values, solver, directions, out,
                             analysis="bifurcation", transient=transient, record=record,
-                            x0=x0, v0=v0, settle=settle, sweep_mode=sweep, workers=workers)
+                            x0=x0, v0=v0, settle=settle, sweep_mode=sweep, workers=workers,
+                            lyapunov=lyapunov)
 
 
 #: Integer codes of the ``sweep`` coordinate (CF flag_values / flag_meanings).
@@ -340,8 +344,9 @@ SWEEP_CODES = {"up": 0, "down": 1, "fresh": 2}
 
 
 def branches_dataset(params, param, values, solver, directions, out, *, workers=None,
-                     **attrs) -> xr.Dataset:
-    """The Dataset of :func:`run_branches` output (classified by :func:`summarize`)."""
+                     lyapunov: bool | None = False, **attrs) -> xr.Dataset:
+    """The Dataset of :func:`run_branches` output (classified by :func:`summarize`; with
+    ``lyapunov``, lambda1 and ``motion`` from ``analysis.stability.lyapunov_variables``)."""
     from ..io import flag_attrs, status_flags
     rows = param_rows(params, param, values)
     period, mx, mn, contact = summarize(out, rows, solver, attrs["transient"], attrs["record"],
@@ -350,6 +355,17 @@ def branches_dataset(params, param, values, solver, directions, out, *, workers=
     desc, unit = spec.long_name, spec.units
     dims = ("sweep", param)
     nfail = int(np.count_nonzero(out["status"]))
+    extra = {}
+    from .stability import lyapunov_variables, wants_lyapunov
+    if wants_lyapunov(lyapunov, solver):
+        nb_, nv = period.shape
+        P = np.ascontiguousarray(np.broadcast_to(rows[None], (nb_, nv, rows.shape[1]))
+                                 .reshape(nb_ * nv, -1))
+        extra = lyapunov_variables(P, solver, out["S"].reshape(nb_ * nv, -1), attrs["record"],
+                                   period, dims)
+        failed = out["status"] != st.OK
+        extra["lambda1"][1][failed] = np.nan
+        extra["motion"][1][failed] = 0
     ds = xr.Dataset(
         {
             "X": (dims + ("n",), out["X"], {"long_name": "section displacement X(kT)",
@@ -367,6 +383,7 @@ def branches_dataset(params, param, values, solver, directions, out, *, workers=
             "transient_used": (dims, out["used"], {
                 "long_name": "forcing periods integrated before the recorded window",
                 "units": "1"}),
+            **extra,
         },
         coords={
             param: (param, values, {"long_name": desc, "units": unit}),

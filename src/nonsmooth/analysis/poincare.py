@@ -179,7 +179,8 @@ def classify(X, V, Xmax, Xmin, M, rtol: float, atol: float, max_period: int = MA
 def poincare(params: ParamsBase, *, record: int | None = None, transient: int, x0: float = 0.0,
              v0: float = 0.0, method: str = "smooth", rtol: float = 1e-8, atol: float = 1e-10,
              transition: str = "eq13", orbit_samples: int = 200, orbit_periods: int | None = None,
-             settle: bool = False, progress=None, points: int | None = None) -> xr.Dataset:
+             settle: bool = False, progress=None, points: int | None = None,
+             lyapunov: bool | None = None) -> xr.Dataset:
     """Stroboscopic Poincaré section of one trajectory from (x0, v0) at t = 0.
 
     Integrates ``transient`` forcing periods (all of them unless ``settle=True``), then records
@@ -193,6 +194,12 @@ def poincare(params: ParamsBase, *, record: int | None = None, transient: int, x
     ``orbit_periods`` further periods (default: the detected period, or 20 periods when not
     periodic) at ``orbit_samples`` per period; it starts on the last section point, so the
     section points lie on it. ``progress(done, total)`` is called between time slices.
+
+    ``lyapunov`` (None = where tangent dynamics exist, i.e. not for eq. 12): also ``lambda1`` (largest Lyapunov exponent, per unit time) with its
+    ``lambda1_stderr`` over ``record`` further periods of the attractor reached (tangent
+    dynamics with saltation matrices, ``analysis.stability``), and ``motion``: periodic (a
+    period was found), chaotic (lambda1 > 0 beyond 3 standard errors), quasi-periodic (no
+    period, lambda1 within 3 errors of 0) or not settled.
 
     Raises IntegrationError if the trajectory fails (sweeps record failures instead).
     """
@@ -235,6 +242,11 @@ def poincare(params: ParamsBase, *, record: int | None = None, transient: int, x
 
     T = params.period
     regions = flag_attrs(params.model.mode_names, dtype=np.int8)
+    extra = {}
+    from .stability import lyapunov_variables, wants_lyapunov
+    if wants_lyapunov(lyapunov, solver):
+        extra = lyapunov_variables(p[None, :], solver, out["S"][0], record,
+                                   np.array([period]), ())
     ds = xr.Dataset(
         {
             "X": ("n", X, {"long_name": "section displacement X(t_section)", "units": "1"}),
@@ -254,6 +266,7 @@ def poincare(params: ParamsBase, *, record: int | None = None, transient: int, x
             "orbit_X": ("sample", oX, {"long_name": "phase-portrait displacement", "units": "1"}),
             "orbit_V": ("sample", oV, {"long_name": "phase-portrait velocity", "units": "1/s"}),
             "orbit_region": ("sample", oR, dict(regions, long_name="region of eq. 14")),
+            **extra,
         },
         coords={
             "n": ("n", np.arange(record), {"long_name": "section index"}),

@@ -45,6 +45,7 @@ warnings.filterwarnings("ignore", category=nb.NumbaExperimentalFeatureWarning)
 from .. import status as st  # noqa: E402
 from .contract import (  # noqa: E402
     GENERIC_KERNEL_SIGNATURE,
+    TANGENT_KERNEL_SIGNATURE,
     MAX_GUARDS,
     N_STATE,
     OPT_ATOL,
@@ -61,10 +62,12 @@ from .contract import (  # noqa: E402
     ST_VA,
     ST_X,
 )
-from .pwlinear import MC_LMAX, N_MC, accel, eval_state, hom_part, mode_coeffs  # noqa: E402
+from .pwlinear import (MC_A, MC_K, MC_LMAX, N_MC, accel, eval_state, hom_part,  # noqa: E402
+                       mode_coeffs, propagator)
 from .record import record_interval  # noqa: E402
 from .roots import quad_roots01  # noqa: E402
-from .rkstep import _A, _B, _C, _E, _FM, _control, _cubic, _shrink, _x_extrema  # noqa: E402
+from .rkstep import (_A, _B, _C, _E, _FM, _NS, _control, _cubic, _shrink,  # noqa: E402
+                     _x_extrema)
 from .trig import cos_sin_small  # noqa: E402
 
 MAX_MODES = 8  # mode codes 0..7 (bit mask M is uint8)
@@ -98,12 +101,10 @@ def _dgval(G, k, n, du, C, S, om):
     return d
 
 
-@nb.njit(cache=True, fastmath=_FM)
-def _rk_step(field, mode, tau, C, S, h, om, n, u, k0, pp, mem, rtol, atol, us, k1, k2, k3, k4,
-             k5, u1):
-    """One RKF45 step of length h from (tau, u) with field(mode) fixed; k0 = field at the start.
-    Writes the 5th-order solution to u1; returns (squared RMS error norm, cos, sin at the end).
-    The error norm is NaN when u1 is not finite."""
+@nb.njit(cache=True, inline="always", fastmath=_FM)
+def _stage_rotations(om, h):
+    """(cos, sin) of the forcing-phase advance om c h to the RKF45 stages c = 1/4, 3/8, 1/2,
+    1 and 12/13 of a step h, from two short Taylor evaluations (``cos_sin_small``)."""
     c1, s1 = cos_sin_small(om * 0.125 * h)
     c2 = c1 * c1 - s1 * s1
     s2 = 2.0 * c1 * s1
@@ -114,6 +115,16 @@ def _rk_step(field, mode, tau, C, S, h, om, n, u, k0, pp, mem, rtol, atol, us, k
     c8 = c4 * c4 - s4 * s4
     s8 = 2.0 * c4 * s4
     c12, s12 = cos_sin_small(om * _C[3] * h)
+    return c2, s2, c3, s3, c4, s4, c8, s8, c12, s12
+
+
+@nb.njit(cache=True, fastmath=_FM)
+def _rk_step(field, mode, tau, C, S, h, om, n, u, k0, pp, mem, rtol, atol, us, k1, k2, k3, k4,
+             k5, u1):
+    """One RKF45 step of length h from (tau, u) with field(mode) fixed; k0 = field at the start.
+    Writes the 5th-order solution to u1; returns (squared RMS error norm, cos, sin at the end).
+    The error norm is NaN when u1 is not finite."""
+    c2, s2, c3, s3, c4, s4, c8, s8, c12, s12 = _stage_rotations(om, h)
     C1 = C * c8 - S * s8
     S1 = S * c8 + C * s8
     for i in range(n):
@@ -251,11 +262,199 @@ def _cf_state(MC, mode, om, y0, z0, C, S, hs, u1, f1):
     return C1, S1
 
 
-@nb.njit(GENERIC_KERNEL_SIGNATURE, cache=True, fastmath=_FM)
-def advance_generic(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out, M_out,
-                    Xmax_out, Xmin_out):
-    """Kernel contract (see ``integrate.contract``) for a hybrid model given by ``fns``."""
+
+# ---- tangent (variational) dynamics ---------------------------------------------------------
+@nb.njit(cache=True, fastmath=_FM)
+def _rk_tangent(jacobian, mode, tau, C, S, h, om, n, u, k0, k1, k2, k3, k4, k5, pp, mem, Y, W, KY,
+                J, us, cmi):
+    """Propagate the tangent Y (rows: u, then the continuous memory slots ``cmi``) through the
+    RKF45 step just taken (its stages k0..k5, length h): the same Runge-Kutta formula applied
+    to the variational equation Y' = J Y with J the model's Jacobian at each stage state, i.e.
+    the exact derivative of the discrete step (internal differentiation). Memory rows are
+    constant within a mode; J's columns n + slot give the field's dependence on memory."""
+    m = Y.shape[1]
+    ncm = len(cmi)
+    # forcing phase at the stage times 0, 1/4, 3/8, 12/13, 1, 1/2 of the step
+    c2, s2, c3, s3, c4, s4, c8, s8, c12, s12 = _stage_rotations(om, h)
+    for i in range(_NS):
+        if i == 0:
+            cw, sw = 1.0, 0.0
+        elif i == 1:
+            cw, sw = c2, s2
+        elif i == 2:
+            cw, sw = c3, s3
+        elif i == 3:
+            cw, sw = c12, s12
+        elif i == 4:
+            cw, sw = c8, s8
+        else:
+            cw, sw = c4, s4
+        a0, a1, a2, a3, a4 = _A[i, 0], _A[i, 1], _A[i, 2], _A[i, 3], _A[i, 4]
+        for r in range(n):  # the stage state (_A is strictly lower triangular)
+            us[r] = u[r] + h * (a0 * k0[r] + a1 * k1[r] + a2 * k2[r] + a3 * k3[r] + a4 * k4[r])
+        for q in range(ncm):
+            for r in range(n):
+                J[r, n + cmi[q]] = 0.0
+        jacobian(mode, tau + _C[i] * h, C * cw - S * sw, S * cw + C * sw, us, pp, mem, J)
+        for c in range(m):
+            for r in range(n):
+                W[r] = Y[r, c] + h * (a0 * KY[0, r, c] + a1 * KY[1, r, c] + a2 * KY[2, r, c]
+                                      + a3 * KY[3, r, c] + a4 * KY[4, r, c])
+            for r in range(n):
+                acc = 0.0
+                for q in range(n):
+                    acc += J[r, q] * W[q]
+                for q in range(ncm):
+                    acc += J[r, n + cmi[q]] * Y[n + q, c]
+                KY[i, r, c] = acc
+    b0, b1, b2, b3, b4, b5 = _B[0], _B[1], _B[2], _B[3], _B[4], _B[5]
+    for c in range(m):
+        for r in range(n):
+            Y[r, c] += h * (b0 * KY[0, r, c] + b1 * KY[1, r, c] + b2 * KY[2, r, c]
+                            + b3 * KY[3, r, c] + b4 * KY[4, r, c] + b5 * KY[5, r, c])
+
+
+@nb.njit(cache=True, fastmath=_FM)
+def _cf_tangent(MC, mode, om, h, Y):
+    """Y <- Phi(h) Y for a closed-form mode: Phi = exp(A h), A = [[0, 1], [-k, -c]] (the
+    mode's homogeneous propagator); memory rows are unchanged."""
+    eC, eS, cw, sw = propagator(MC, mode, om, h)
+    a = MC[mode, MC_A]
+    k = MC[mode, MC_K]
+    p00 = eC - a * eS
+    p11 = eC + a * eS
+    p10 = -k * eS
+    for c in range(Y.shape[1]):
+        y0 = Y[0, c]
+        y1 = Y[1, c]
+        Y[0, c] = p00 * y0 + eS * y1
+        Y[1, c] = p10 * y0 + p11 * y1
+
+
+@nb.njit(cache=True)
+def _saltation(transition, mode, k, tau, C, S, om, n, ue, me, fm, gk, gdot, new_mode, up, mp,
+               fp, pp, Y, cmi, uc, mc, ua, ma, chained, tw_last):
+    """Y <- the tangent just after the transition (mode, guard k) -> new_mode at (tau, ue, me).
+
+    For a column w = (w_u, w_m) the perturbed trajectory meets the surface g_k = 0 a time
+    tau_w = -(grad g_k . w_u) / g' later (g' = d g_k / dt along the old field fm), at the state
+    ue + w_u + fm tau_w; the transition R (reset and memory writes) maps that point, and the
+    result is carried back by -tau_w along the new field fp:
+
+        w_u+ = D R (w_u + fm tau_w, w_m, tau_w) - fp tau_w,   w_m+ = D R_mem (...)
+
+    which is the saltation matrix I + (fp - fm) grad^T / g' for a switch without reset, and
+    the reset's Jacobian with its correction for an impact. D R along that direction (which
+    lies in the surface) is a central difference of the model's ``transition`` (exact for the
+    affine resets of the built-in models); a one-sided difference is used where the other side
+    leaves for another mode (up, mp: the state and memory after the actual transition).
+
+    A transition with g' >= 0 is not a transversal crossing but a round-off exit (e.g. a frozen
+    state a hair outside its band, found at a step end): its time is set by the step grid,
+    not by the state, so tau_w = 0 there; except when it is ``chained`` to a transition at the
+    same instant (a tangential exit through a surface the state sits on, e.g. a frozen stick
+    velocity on its band edge leaving the band as soon as the friction saturates): every
+    nearby trajectory then leaves at once too, so its time shift is that of the transition
+    before (``tw_last``, per column, updated here). Returns False if the new tangent is not finite (a
+    grazing touch, g' -> 0-, makes the saltation unbounded)."""
+    ncm = len(cmi)
+    scale = 1.0
+    for i in range(n):
+        scale = max(scale, abs(ue[i]))
+    for c in range(Y.shape[1]):
+        tw = 0.0
+        for i in range(n):
+            tw += gk[i] * Y[i, c]
+        gn = 0.0
+        for i in range(n):
+            gn += abs(gk[i] * fm[i])
+        if chained and not gdot < -1e-6 * gn:
+            tw = tw_last[c]
+        else:
+            tw = -tw / gdot if gdot < 0.0 else 0.0
+        tw_last[c] = tw
+        dn = abs(tw) * om
+        for i in range(n):
+            dn = max(dn, abs(Y[i, c] + fm[i] * tw))
+        for q in range(ncm):
+            dn = max(dn, abs(Y[n + q, c]))
+        if dn == 0.0:
+            continue
+        eps = 1e-7 * scale / dn
+        ok_side = 0
+        for side in (1.0, -1.0):
+            e = side * eps
+            for i in range(n):
+                uc[i] = ue[i] + e * (Y[i, c] + fm[i] * tw)
+            for i in range(len(me)):
+                mc[i] = me[i]
+            for q in range(ncm):
+                mc[cmi[q]] += e * Y[n + q, c]
+            cw = math.cos(om * e * tw)
+            sw = math.sin(om * e * tw)
+            got = transition(mode, k, tau + e * tw, C * cw - S * sw, S * cw + C * sw, uc, pp, mc)
+            if side > 0.0:
+                for i in range(n):
+                    ua[i] = uc[i]
+                for q in range(ncm):
+                    ma[q] = mc[cmi[q]]
+                if got == new_mode:
+                    ok_side += 1
+            elif got == new_mode:
+                ok_side += 2
+        # derivative of R along the direction: central, else one-sided against the actual R
+        for i in range(n):
+            if ok_side == 3 or ok_side == 0:
+                d = (ua[i] - uc[i]) / (2.0 * eps)
+            elif ok_side == 1:
+                d = (ua[i] - up[i]) / eps
+            else:
+                d = (up[i] - uc[i]) / eps
+            Y[i, c] = d - fp[i] * tw
+        for q in range(ncm):
+            if ok_side == 3 or ok_side == 0:
+                d = (ma[q] - mc[cmi[q]]) / (2.0 * eps)
+            elif ok_side == 1:
+                d = (ma[q] - mp[cmi[q]]) / eps
+            else:
+                d = (mp[cmi[q]] - mc[cmi[q]]) / eps
+            Y[n + q, c] = d
+    for c in range(Y.shape[1]):
+        for i in range(Y.shape[0]):
+            if not math.isfinite(Y[i, c]):
+                return False
+    return True
+
+
+@nb.njit(cache=True, fastmath=_FM)
+def _qr_logs(Y, out, row):
+    """Modified Gram-Schmidt (twice) of the columns of Y in place; log of the norms -> out[row]
+    when row >= 0 (Benettin's re-orthonormalisation)."""
+    N, m = Y.shape
+    for c in range(m):
+        for _ in range(2):
+            for q in range(c):
+                d = 0.0
+                for i in range(N):
+                    d += Y[i, q] * Y[i, c]
+                for i in range(N):
+                    Y[i, c] -= d * Y[i, q]
+        nr = 0.0
+        for i in range(N):
+            nr += Y[i, c] * Y[i, c]
+        nr = math.sqrt(nr)
+        if row >= 0:
+            out[row, c] = math.log(nr) if nr > 0.0 else -np.inf
+        if nr > 0.0:
+            for i in range(N):
+                Y[i, c] /= nr
+
+
+@nb.njit(cache=True, fastmath=_FM)
+def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out, M_out,
+             Xmax_out, Xmin_out, Y, L_out, cmi, qr):
     field, jacobian, guards, transition, initial, linear = fns
+    tan = Y.shape[1] > 0
     n = int(opts[OPT_N])
     nmem = int(opts[OPT_NMEM])
     if n < 2 or nmem < 0 or n - 2 + nmem > N_STATE - ST_EXTRA:
@@ -284,6 +483,24 @@ def advance_generic(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out
     MC = np.zeros((MAX_MODES, N_MC))
     mcs = np.zeros(MAX_MODES, np.int64)
     lin = np.zeros(4)
+    # tangent work arrays (empty without a tangent)
+    nt = n if tan else 0
+    mt = Y.shape[1]
+    KY = np.zeros((_NS, nt, mt))
+    W = np.zeros(nt)
+    J = np.zeros((nt, n + nmem if tan else 0))
+    ue = np.zeros(nt)
+    fm = np.zeros(nt)
+    gk = np.zeros(nt)
+    uc = np.zeros(nt)
+    ua = np.zeros(nt)
+    me = np.zeros(len(mem) if tan else 0)
+    mc = np.zeros(len(mem) if tan else 0)
+    ma = np.zeros(len(cmi))
+    tw_last = np.zeros(mt)
+    for q in range(len(cmi)):
+        if cmi[q] < 0 or cmi[q] >= nmem:
+            return st.NON_FINITE
 
     u[0] = state[ST_X]
     u[1] = state[ST_V]
@@ -470,6 +687,12 @@ def advance_generic(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out
                     # step-size control after an accepted step without a switch
                     h = _control(err2, hs, h, last, rejected)
                     rejected = False
+                if tan:
+                    if cf:
+                        _cf_tangent(MC, mode, om, hs, Y)
+                    else:
+                        _rk_tangent(jacobian, mode, tau, C, S, hs, om, n, u, f0, k1, k2, k3, k4,
+                                    k5, pp, mem, Y, W, KY, J, us, cmi)
                 if cf:
                     xmax, xmin = _x_extrema_exact(MC, mode, om, y0, z0, C, S, u[0], u[1], u1[0],
                                                   u1[1], hs, xmax, xmin)
@@ -485,6 +708,16 @@ def advance_generic(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out
                 xmin = min(xmin, u[0])
             if k_tr >= 0:
                 # ---- transition through guard k_tr at (tau, u) ----
+                gdot = 0.0
+                old_mode = mode
+                if tan:
+                    for i in range(n):
+                        ue[i] = u[i]
+                        fm[i] = f0[i]
+                        gk[i] = G[k_tr, i]
+                    for i in range(len(mem)):
+                        me[i] = mem[i]
+                    gdot = _dgval(G, k_tr, n, f0, C, S, om)
                 new_mode = transition(mode, k_tr, tau, C, S, u, pp, mem)
                 if tau - t_switch < zeno_dt:
                     n_tiny += 1
@@ -506,6 +739,11 @@ def advance_generic(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out
                     break
                 cf = cls == _MC_CLOSED
                 _deriv(cf, field, mode, tau, C, S, u, pp, mem, f0, MC, om)
+                if tan and not _saltation(transition, old_mode, k_tr, tau, C, S, om, n, ue, me,
+                                          fm, gk, gdot, mode, u, mem, f0, pp, Y, cmi, uc, mc,
+                                          ua, ma, n_tiny > 0, tw_last):
+                    code = st.GRAZING
+                    break
                 ok = True
                 for i in range(n):
                     if not math.isfinite(u[i]):
@@ -525,7 +763,36 @@ def advance_generic(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out
             S = 0.0
             rejected = False
             _deriv(cf, field, mode, tau, C, S, u, pp, mem, f0, MC, om)
+            if tan and qr == 1:
+                _qr_logs(Y, L_out, it - n_skip)
         record_interval(it, n_skip, u[0], u[1], mode, mask, xmax, xmin, X_out, V_out, R_out,
                         M_out, Xmax_out, Xmin_out)
     _store(state, u, n, mem, nmem, mode, h)
     return code
+
+
+@nb.njit(GENERIC_KERNEL_SIGNATURE, cache=True, fastmath=_FM)
+def advance_generic(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out, M_out,
+                    Xmax_out, Xmin_out):
+    """Kernel contract (see ``integrate.contract``) for a hybrid model given by ``fns``."""
+    return _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out, M_out,
+                    Xmax_out, Xmin_out, np.zeros((0, 0)), np.zeros((0, 0)),
+                    np.zeros(0, np.int64), 0)
+
+
+@nb.njit(TANGENT_KERNEL_SIGNATURE, cache=True, fastmath=_FM)
+def advance_tangent(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out, M_out,
+                    Xmax_out, Xmin_out, Y, L_out, cmi, qr):
+    """``advance_generic`` that also carries tangent vectors (the columns of Y) along the
+    trajectory: the variational equation of each mode (``_rk_tangent`` / ``_cf_tangent``) and
+    the saltation matrix of every transition (``_saltation``). Rows of Y: the state u (n), then
+    the continuous memory slots ``cmi`` (e.g. the eq. 13a entry velocity). With ``qr`` = 1 the
+    columns are re-orthonormalised at every forcing-period end (Benettin) and the logs of the
+    norms of the recorded periods go to ``L_out[period - n_skip]`` (per_period must be 1);
+    with ``qr`` = 0, Y is left as the product (the monodromy of the stroboscopic map when
+    Y starts as the identity)."""
+    if Y.shape[0] != int(opts[OPT_N]) + len(cmi) or (qr == 1 and (
+            per_period != 1 or L_out.shape[0] < n_out or L_out.shape[1] < Y.shape[1])):
+        return st.NON_FINITE
+    return _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out, M_out,
+                    Xmax_out, Xmin_out, Y, L_out, cmi, qr)

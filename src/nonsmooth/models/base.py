@@ -201,7 +201,10 @@ class Method:
     form. ``modes``: the mode codes this method uses. ``rtol``/``atol``: tolerances it
     enforces at most (the exact method of a model with nonlinear modes integrates those at a
     tight tolerance). ``kernel``: a specialised kernel code of a built-in model, else the
-    generic kernel."""
+    generic kernel. ``continuous_memory``: the memory slots that are continuous functions of
+    the state (e.g. an entry velocity), as opposed to discrete flags; tangent dynamics carry
+    them, and ``jacobian`` must give the field's derivative with respect to slot i in column
+    n + i of J (J has n + n_memory columns, the memory ones zeroed before each call)."""
 
     field: Callable
     jacobian: Callable
@@ -216,6 +219,7 @@ class Method:
     rtol: float | None = None
     atol: float | None = None
     kernel: int = KERNEL_GENERIC
+    continuous_memory: tuple = ()
 
 
 def _no_linear(mode, p, out):
@@ -436,27 +440,37 @@ def _sample_check(model, method, m, fns, max_guards):
     mem = np.zeros(max(1, model.n_memory))
     u = np.full(n, 0.5)
     du = np.zeros(n)
-    J = np.zeros((n, n))
+    J = np.zeros((n, n + model.n_memory))
     G = np.zeros((max_guards, n + 3))
+    cm = tuple(m.continuous_memory)
+    if any(not (isinstance(i, int) and 0 <= i < model.n_memory) for i in cm):
+        raise bad(f"continuous_memory {cm} names slots outside 0..{model.n_memory - 1}")
     t, c, s = 0.1, math.cos(0.1), math.sin(0.1)
     for mode in (m.modes or tuple(range(len(model.mode_names)))):
         name = model.mode_names[mode]
         call_field(fns, mode, t, c, s, u, p, mem, du)
         if not np.all(np.isfinite(du)):
             raise bad(f"field is not finite in mode {name} at the sample point u = 0.5")
+        J[:] = 0.0
         call_jacobian(fns, mode, t, c, s, u, p, mem, J)
-        fd = np.empty((n, n))
-        for j in range(n):
-            h = 1e-6 * max(1.0, abs(u[j]))
-            up, um, dp, dm = u.copy(), u.copy(), np.empty(n), np.empty(n)
-            up[j] += h
-            um[j] -= h
-            call_field(fns, mode, t, c, s, up, p, mem, dp)
-            call_field(fns, mode, t, c, s, um, p, mem, dm)
+        cols = list(range(n)) + [n + i for i in cm]
+        fd = np.zeros_like(J)
+        for j in cols:  # the state's columns, then the continuous memory's
+            v = u if j < n else mem
+            jj = j if j < n else j - n
+            h = 1e-6 * max(1.0, abs(v[jj]))
+            dp, dm = np.empty(n), np.empty(n)
+            for sign, out in ((1.0, dp), (-1.0, dm)):
+                w = v.copy()
+                w[jj] += sign * h
+                uu, mm = (w, mem) if j < n else (u, w)
+                call_field(fns, mode, t, c, s, uu, p, mm, out)
             fd[:, j] = (dp - dm) / (2 * h)
-        scale = max(1.0, float(np.max(np.abs(fd))))
-        if not np.all(np.abs(J - fd) <= 1e-5 * scale):
-            i, j = np.unravel_index(np.argmax(np.abs(J - fd)), J.shape)
+        scale = max(1.0, float(np.max(np.abs(fd[:, cols]))))
+        err = np.abs(J - fd)[:, cols]
+        if not np.all(err <= 1e-5 * scale):
+            i, j = np.unravel_index(np.argmax(err), err.shape)
+            j = cols[j]
             raise bad(f"jacobian disagrees with the field in mode {name}: J[{i},{j}] = "
                       f"{J[i, j]:.6g}, finite differences give {fd[i, j]:.6g}")
         ng = int(call_guards(fns, mode, p, mem, G))

@@ -188,6 +188,9 @@ def smooth_guards(mode, p, mem, G):
     return 3
 
 
+_STICK_INSET = 1e-9  # smooth stick: V frozen this fraction of eta inside the band edge
+
+
 @nb.njit(cache=True, inline="always")
 def _smooth_band(X, V, c, p, mem):
     """Mode in the band |v_rel| <= eta (writes the sign of f_req for the transition mode)."""
@@ -201,7 +204,15 @@ def _smooth_band(X, V, c, p, mem):
 def smooth_transition(mode, k, t, c, s, u, p, mem):
     X, V = u[0], u[1]
     if mode == SLIP_F or mode == SLIP_B:
-        return _smooth_band(X, V, c, p, mem)
+        new = _smooth_band(X, V, c, p, mem)
+        if new == STICK:
+            # freeze V a fixed hair inside the band edge it crossed, not at the located
+            # crossing: a value a round-off outside the band would leave stick again at once,
+            # and the later exit through that edge (stick -> transition -> slip, a tangential
+            # exit) would depend on the location error through a square root
+            side = 1.0 if mode == SLIP_F else -1.0
+            u[1] = p[_VB] + side * p[_ETA] * (1.0 - _STICK_INSET)
+        return new
     if k == 0:
         return SLIP_F
     if k == 1:

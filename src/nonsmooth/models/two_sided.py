@@ -171,6 +171,9 @@ def smooth_jacobian(mode, t, c, s, u, p, mem, J):
         elif lr == _SA:
             va = mem[_VA_R] if side == 0 else mem[_VA_L]
             ax, av = ax - 0.5 * w2 - sg * x * va / (2.0 * eta), av - x
+            # d/d va (eq. 13a memory of this side)
+            J[1, 2 + (_VA_R if side == 0 else _VA_L)] = x * (1.0 - (sg * u[0] - g + eta)
+                                                              / (2.0 * eta))
         else:
             ax, av = ax - 0.5 * w2, av - 0.5 * x
     J[0, 0] = 0.0
@@ -459,7 +462,7 @@ MODEL = Model(
     methods={
         "smooth": Method(smooth_field, smooth_jacobian, smooth_guards, smooth_transition,
                          smooth_initial, modes=(0, 1, 2, 3, 4, 5, 6),
-                         flow_is_homeomorphism=True,
+                         flow_is_homeomorphism=True, continuous_memory=(_VA_R, _VA_L),
                          description="switch model (eq. 13) at each support, RKF45 with "
                                      "located switches"),
         "exact": Method(exact_field, exact_jacobian, exact_guards, exact_transition,

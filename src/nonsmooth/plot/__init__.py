@@ -34,6 +34,8 @@ _PLOTS = {
     "plot_support_stiffness": ".reproduce_panels",
     "plot_coexisting": ".reproduce_panels",
     "plot_section_panel": ".reproduce_panels",
+    "plot_lyapunov": ".stability",
+    "plot_orbit": ".stability",
 }
 
 __all__ = ["MODE_COLORS", "MODE_LABELS", "LINE_LABELS", "REGION_COLORS", "REGION_LABELS",

@@ -23,11 +23,26 @@ def sweep_names(ds) -> list[str]:
     return [meanings[int(c)] for c in np.atleast_1d(sw.values)]
 
 
-def plot_bifurcation(ds, var: str = "X"):
+def plot_bifurcation(ds, var: str = "X", lyapunov=None):
     """Section ``var`` (X or V) of every recorded period versus the swept parameter; up and
-    down sweeps in different colours and markers, small dots; failed points are left out."""
+    down sweeps in different colours and markers, small dots; failed points are left out.
+
+    ``lyapunov``: None (default) adds a panel below the diagram, sharing its x axis, with the
+    largest Lyapunov exponent ``lambda1`` of every value per sweep (error bars: its standard
+    error ``lambda1_stderr``) and the zero line, when the Dataset has ``lambda1``; False never
+    draws it; True requires ``lambda1``."""
     param = ds.attrs["swept_param"]
-    fig, ax = new_figure(figsize=(10, 5.5))
+    has = "lambda1" in ds.data_vars
+    if lyapunov and not has:
+        from ..errors import ParameterError
+        raise ParameterError("lyapunov: the Dataset has no lambda1 (compute it with "
+                             "lyapunov=True)")
+    panel = has if lyapunov is None else bool(lyapunov)
+    if panel:
+        fig, (ax, lax) = new_figure(2, 1, figsize=(10, 7.5), sharex=True,
+                                    gridspec_kw=dict(height_ratios=(3, 1.3)))
+    else:
+        fig, ax = new_figure(figsize=(10, 5.5))
     vals = ds[param].values
     nsw = ds.sizes["sweep"]
     npts = vals.size * ds.sizes["n"]
@@ -47,6 +62,10 @@ def plot_bifurcation(ds, var: str = "X"):
     unit = ds[param].attrs.get("units", "")
     sym = param_symbol(model_of(ds), param)
     ax.set_xlabel(f"{sym} [{unit}]" if unit else sym)
+    if panel:  # the label goes below the lambda1 panel (kept, hidden, on the diagram's axes)
+        draw_lambda1(lax, ds, param, vals)
+        lax.set_xlabel(ax.get_xlabel())
+        ax.xaxis.label.set_visible(False)
     ax.set_ylabel(r"$X(kT)$" if var == "X" else r"$\dot X(kT)$")
     ax.set_xlim(vals[0], vals[-1])
     ttl = f"bifurcation diagram, {ds.sizes['n']} section points per value"
@@ -75,3 +94,27 @@ def draw_lines_over(ax, ds, param, vals, style=None):
         else:
             ax.plot(vals, ys, label=lab, **style)
 
+
+
+def draw_lambda1(ax, ds, param, vals):
+    """lambda1 (per unit time) versus the swept parameter, one series per sweep direction, with
+    its standard error as error bars, and the zero line (chaos: above it beyond the errors)."""
+    sw = "sweep" in ds["lambda1"].dims
+    order = ("sweep", param) if sw else (param,)
+    lam = np.asarray(ds["lambda1"].transpose(*order).values, dtype=float)
+    err = (np.asarray(ds["lambda1_stderr"].transpose(*order).values, dtype=float)
+           if "lambda1_stderr" in ds else np.full_like(lam, np.nan))
+    names = sweep_names(ds) if sw else [""]
+    lam, err = lam.reshape(len(names), -1), err.reshape(len(names), -1)
+    for j, name in enumerate(names):
+        style = dict(SWEEP_STYLE.get(str(name), dict(color="0.3", marker=".", label=str(name))))
+        ok = np.isfinite(lam[j])
+        e = np.where(np.isfinite(err[j]), err[j], 0.0)[ok]
+        ax.errorbar(vals[ok], lam[j][ok], yerr=e, fmt=style.pop("marker"), ms=3, lw=0.6,
+                    elinewidth=0.6, capsize=0, alpha=0.8, **style)
+    ax.axhline(0.0, color="k", lw=0.7)
+    unit = ds["lambda1"].attrs.get("units", "1/s")
+    ax.set_ylabel(rf"$\lambda_1$ [{unit}]")
+    ax.grid(True, lw=0.3, alpha=0.5)
+    if len(names) > 1:
+        ax.legend(loc="best", fontsize=7, markerscale=2)

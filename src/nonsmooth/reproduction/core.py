@@ -17,6 +17,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Callable
 
+import numpy as np
+
 AGREES = "agrees"
 DIFFERS = "differs"
 NOT_STATED = "not stated"
@@ -238,6 +240,78 @@ def period_text(p) -> str:
     if p < 0:
         return "not settled (no period can be told yet; a longer transient is needed)"
     return f"period {p}"
+
+
+def _pm(x: float, err: float) -> str:
+    """'0.058 ± 0.0061': the error to 2 significant digits, x to the same decimals."""
+    if not (math.isfinite(x) and math.isfinite(err)) or err <= 0:
+        return f"{fmt(x, 3)} ± {fmt(err, 2)}"
+    dec = max(0, 1 - math.floor(math.log10(err)))
+    return f"{x:.{dec}f} ± {err:.{dec}f}"
+
+
+def lyapunov_text(src, *, with_period: bool = True, **sel) -> str:
+    """Evidence for a claim of chaos: the detected period beside the largest Lyapunov exponent
+    with its standard error and the library's verdict (``motion``), e.g. "not periodic (period
+    0), lambda1 = 0.058 ± 0.006 /s > 0 (9.5 errors): chaotic".
+
+    ``src``: a Dataset of ``poincare`` / ``bifurcation_diagram`` (``lambda1``,
+    ``lambda1_stderr``, ``motion``, ``period``; ``sel`` picks one point of a sweep, e.g.
+    ``sweep=0, omega=0.92``, by position for an integer and by label otherwise), a
+    ``lyapunov`` Dataset (``lyapunov_class``), or a tuple ``(lambda1, stderr[, motion[,
+    period]])``. Only lambda1 > N_SIGMA errors is called chaotic; within the errors of 0 the
+    text says that the run cannot tell quasi-periodic motion or a long transient from chaos."""
+    from ..analysis.stability import CHAOTIC, N_SIGMA, VERDICTS, classify
+    if isinstance(src, tuple):
+        lam, err, motion, period = (tuple(src) + (None, None))[:4]
+    else:
+        def get(name):
+            if name not in src:
+                return None
+            da = src[name]
+            for dim, key in sel.items():
+                if dim in da.dims:
+                    da = da.isel({dim: key}) if isinstance(key, (int, np.integer)) \
+                        else da.sel({dim: key}, method="nearest")
+            return da.values.item() if da.ndim == 0 else None
+        lam, err = get("lambda1"), get("lambda1_stderr")
+        motion = get("motion")
+        if motion is None:
+            motion = get("lyapunov_class")
+        period = get("period")
+    head = ""
+    if with_period and period is not None:
+        p = period_text(period)
+        head = ("not periodic (period 0)" if p.startswith("not periodic") else p) + ", "
+    try:
+        lam, err = float(lam), float(err)
+    except (TypeError, ValueError):
+        return head + "lambda1 not computed"
+    if math.isnan(lam):
+        return head + "lambda1 not computed (NaN)"
+    if lam == -math.inf:
+        return head + "lambda1 = -inf /s: perturbations are annihilated (sticking), not chaos"
+    per = None if period is None or (isinstance(period, float) and math.isnan(period)) \
+        else int(period)
+    if motion is None or int(motion) == 0:
+        motion = classify(lam, err, per if per is not None else 0)
+    verdict = VERDICTS.get(int(motion), "unknown")
+    val = f"lambda1 = {_pm(lam, err)} /s"
+    if not err > 0 or not math.isfinite(err):
+        return head + f"{val} (no error estimate): {verdict}"
+    z = lam / err
+    if lam > N_SIGMA * err:
+        rel = f"> 0 ({z:.1f} errors)"
+        word = "chaotic" if int(motion) == CHAOTIC else verdict
+    elif abs(lam) <= N_SIGMA * err:
+        rel = f"within {N_SIGMA:g} errors of 0"
+        word = ("periodic (a neutral direction)" if per is not None and per > 0 else
+                "quasi-periodic or a long transient; chaos is not shown by lambda1")
+    else:
+        rel = f"< 0 ({-z:.1f} errors)"
+        word = ("periodic" if per is not None and per > 0 else
+                "contracting: a period longer than the search or a transient, not chaos")
+    return head + f"{val} {rel}: {word}"
 
 
 def verdict_period(claimed: int, measured) -> str:

@@ -143,7 +143,7 @@ def basins(params: ParamsBase, *, x=(-3.0, 3.0), v=(-3.0, 3.0), grid=400, method
            transient: int = 10, max_periods: int = 1000, max_period: int = 16, rtol: float = 1e-8,
            atol: float = 1e-10, transition: str = "eq13", early_stop: bool = True,
            samples_per_period: int = 200, workers: int | None = None,
-           progress=None) -> xr.Dataset:
+           progress=None, lyapunov: bool | None = None) -> xr.Dataset:
     """Basins of attraction of the stroboscopic map on a grid of initial conditions.
 
     ``x``, ``v``: (min, max) ranges of the initial X and V (forcing phase 0); ``grid``: points
@@ -166,8 +166,13 @@ def basins(params: ParamsBase, *, x=(-3.0, 3.0), v=(-3.0, 3.0), grid=400, method
     ones; NaN-padded) with ``capture_radius``, and on (attractor, sample) the sampled orbit
     ``orbit_X``/``orbit_V`` (time coordinate ``orbit_t``, in forcing periods). The
     ``fraction`` values and ``undecided_fraction`` sum to 1. See the module docstring for the
-    algorithm.
+    algorithm. ``lyapunov`` (None = where tangent dynamics exist, i.e. not for eq. 12): also
+    each attractor's ``lambda1`` with ``lambda1_stderr`` (per
+    unit time, over ``LYAPUNOV_PERIODS`` periods from its first section point: tangent
+    dynamics with saltation matrices, ``analysis.stability``); for a periodic attractor it is
+    ln|mu_1| / T of its leading Floquet multiplier.
     """
+    from ..stability import wants_lyapunov
     params = check_params(params)
     x_lo, x_hi = _check_range("x", x)
     v_lo, v_hi = _check_range("v", v)
@@ -223,6 +228,9 @@ def basins(params: ParamsBase, *, x=(-3.0, 3.0), v=(-3.0, 3.0), grid=400, method
             if chaos is not None:
                 label[members] = found.add(*chaos, kind=KIND_CHAOTIC)
         orbits = _sample_orbits(found, solver, pk, spp)
+        lyap = None
+        if wants_lyapunov(lyapunov, solver):
+            lyap = _attractor_lyapunov(found, solver, pk)
 
     # back to grid order, canonical labels
     grid = {}
@@ -250,7 +258,7 @@ def basins(params: ParamsBase, *, x=(-3.0, 3.0), v=(-3.0, 3.0), grid=400, method
             UserWarning, stacklevel=2)
     return _dataset(params, solver, xs, vs, grid_label.reshape(nx, nv),
                     grid["used"].reshape(nx, nv), grid["status"].reshape(nx, nv), found, key,
-                    kind, contact, periods, max_x, orbits, spp,
+                    kind, contact, periods, max_x, orbits, spp, lyap,
                     dict(transient=transient, max_periods=max_periods, max_period=max_period,
                          early_stop=int(bool(early_stop)), section_tol=tol,
                          match_tol=found.match_tol,
@@ -367,6 +375,21 @@ def _sample_orbits(found, solver, pk, spp):
     return out
 
 
+#: Periods over which an attractor's lambda1 is estimated.
+LYAPUNOV_PERIODS = 400
+
+
+def _attractor_lyapunov(found, solver, pk):
+    """(lambda1, stderr) per attractor (order of ``found``), from its first section point."""
+    from ..stability import lambda1_points
+    if not found.points:
+        return np.zeros(0), np.zeros(0)
+    states = np.stack([new_state(pts[0, 0], pts[0, 1]) for pts in found.points])
+    P = np.tile(pk, (len(states), 1))
+    lam, err, _ = lambda1_points(P, solver, states, LYAPUNOV_PERIODS)
+    return lam, err
+
+
 def _label_meanings(key, kind, contact, periods):
     """One CF flag meaning per label value: undecided, then attractor_<k>_<kind>_<contact>."""
     words = ["undecided"]
@@ -377,7 +400,7 @@ def _label_meanings(key, kind, contact, periods):
 
 
 def _dataset(params, solver, xs, vs, label, used, status, found, key, kind, contact, periods,
-             max_x, orbits, spp, extra):
+             max_x, orbits, spp, lyap, extra):
     n = label.size
     n_att = len(key)
     npt = max([len(found.points[k]) for k in key], default=1)
@@ -398,6 +421,16 @@ def _dataset(params, solver, xs, vs, label, used, status, found, key, kind, cont
     counts = np.array([np.count_nonzero(label == k) for k in range(n_att)], dtype=np.int64)
     undecided = int(np.count_nonzero(label < 0))
     failed = int(np.count_nonzero(status != 0))
+    lyap_vars = {}
+    if lyap is not None:
+        lyap_vars = {
+            "lambda1": ("attractor", lyap[0][key], {
+                "long_name": "largest Lyapunov exponent of the attractor (tangent dynamics with "
+                             "saltation matrices)", "units": "1/s",
+                "periods": LYAPUNOV_PERIODS}),
+            "lambda1_stderr": ("attractor", lyap[1][key], {
+                "long_name": "standard error of lambda1 (10 block means)", "units": "1/s"}),
+        }
     ds = xr.Dataset(
         {
             "label": (("x0", "v0"), label.astype(np.int32), flag_attrs(
@@ -439,6 +472,7 @@ def _dataset(params, solver, xs, vs, label, used, status, found, key, kind, cont
             "orbit_V": (("attractor", "sample"), OV,
                         {"long_name": "attractor orbit V from its first section point",
                          "units": "1/s"}),
+            **lyap_vars,
         },
         coords={
             "x0": ("x0", xs, {"long_name": "initial X", "units": "1"}),

@@ -73,6 +73,7 @@ MODEL = _SupportModel(
         "smooth": Method(g.smooth_field, g.smooth_jacobian, g.smooth_guards,
                          g.smooth_transition, g.smooth_initial, modes=(0, 1, 2, 3),
                          flow_is_homeomorphism=True, kernel=KERNEL_SUPPORT_SMOOTH,
+                         continuous_memory=(0,),
                          description="switch model, eqs. 10-14 (RKF45, located switches)"),
         "exact": Method(g.exact_field, g.exact_jacobian, g.exact_guards, g.exact_transition,
                         g.exact_initial, g.exact_linear, closed_form=True, modes=(0, 3),

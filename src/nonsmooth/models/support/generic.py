@@ -53,6 +53,7 @@ def smooth_jacobian(mode, t, c, s, u, p, mem, J):
         ax, av = ax - ws2, av - xis
     elif mode == SIGMA_ALPHA:
         ax, av = ax - 0.5 * ws2 - xis * mem[0] / (2.0 * eta), av - xis
+        J[1, 2] = xis * (1.0 - (u[0] - 1.0 + eta) / (2.0 * eta))  # d/d mem[0] (Va, eq. 13a)
     elif mode == SIGMA_BETA:
         ax, av = ax - 0.5 * ws2, av - 0.5 * xis
     J[0, 0] = 0.0

@@ -6,8 +6,8 @@ import numpy as np
 
 from ...presets import preset
 from ..access import number, value, x_extrema
-from ..core import DIFFERS, NOT_STATED, agree_if, figure, fmt, period_text
-from ._common import IC, gap, method_text, region_names
+from ..core import DIFFERS, NOT_STATED, agree_if, figure, fmt, lyapunov_text, period_text
+from ._common import IC, attractor_note, gap, ic_grid, method_text, note_safely, region_names
 
 
 FIG4_ETAS = (0.28, 0.028, 0.0028, 0.00028)
@@ -112,9 +112,14 @@ def fig4(ctx, rec):
                         "last row, not of this one)")
         rec.check(text, measured, v, fig4_evidence(ctx, ds, i, p, kw) if v == DIFFERS else "")
     small = [int(ds["period"].values[int(np.argmin(np.abs(etas - e)))]) for e in (0.0028, 0.00028)]
+    lyap = chaos_evidence(ctx, p, small, transient)
     rec.check("the parameters give a chaotic response (for the small eta)",
-              f"detected: {period_text(small[0])} (eta 2.8e-3), {period_text(small[1])} (eta 2.8e-4)",
-              agree_if(all(s == 0 for s in small)))
+              f"detected: {period_text(small[0])} (eta 2.8e-3), {period_text(small[1])} (eta 2.8e-4)"
+              f"; {lyap[0]}",
+              agree_if(all(s == 0 for s in small)), lyap[1])
+    note_safely(rec, lambda: attractor_note(
+        ctx, p, "Coexisting attractors beside the chaotic one (not in the paper)",
+        ic_grid(ctx.setting("coexisting attractors", "grid"))))
     rec_eta = number(ds, "recommended_eta")
     rows = "; ".join(f"eta {e:g}: {'agrees' if a else 'does not'} (distance {fmt(d, 3)})"
                      for e, a, d in zip(etas, ds["agrees"].values, ds["distance_to_exact"].values))
@@ -126,6 +131,27 @@ def fig4(ctx, rec):
               NOT_STATED)
     gap(ctx, "eta", f"Fig. 4 case: the largest eta agreeing with the exact model is {fmt(rec_eta)}")
     ctx.savefig(plot_eta_study(ds), "fig4")
+
+
+def chaos_evidence(ctx, p, small, transient) -> tuple[str, str]:
+    """lambda1 of the two small eta (the smoothed model) and of the exact model, from the
+    figure's initial condition after its transient: (text for the row, evidence)."""
+    from ...analysis.stability import lyapunov
+    n = ctx.setting("fig4", "lambda1 periods")
+    kw = dict(periods=n, transient=transient, x0=IC[0], v0=IC[1], blocks=10)
+    parts = []
+    for eta, per in zip((0.0028, 0.00028), small):
+        try:
+            d = lyapunov(p.replace(eta=eta), **kw)
+            parts.append(f"eta {eta:g}: {lyapunov_text(d, with_period=False)}")
+        except Exception as exc:  # noqa: BLE001 - evidence only
+            parts.append(f"eta {eta:g}: lambda1 failed ({exc})")
+    try:
+        ex = lyapunov_text(lyapunov(p, method="exact", **kw), with_period=False)
+    except Exception as exc:  # noqa: BLE001
+        ex = f"failed ({exc})"
+    return (f"lambda1 over {n} periods after the transient (same start): " + "; ".join(parts),
+            f"exact model (eta = 0), same start and periods: {ex}")
 
 
 def fig4_evidence(ctx, ds, i, p, kw) -> str:

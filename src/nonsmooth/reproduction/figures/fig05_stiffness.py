@@ -8,7 +8,7 @@ from ...params import PARAM_INFO
 from ...presets import preset
 from ..access import value, x_extrema
 from ..core import DIFFERS, NOT_STATED, agree_if, figure, fmt, period_text
-from ._common import IC, method_text, run_poincare
+from ._common import IC, attractor_note, ic_grid, method_text, note_safely, run_poincare
 
 
 FIG5_OMEGA_S = (1.0, 3.16, 10.0, 31.6, 100.0)
@@ -77,3 +77,8 @@ def fig5(ctx, rec):
     ctx.savefig(plot_support_stiffness(ds), "fig5")
     rec.check("max X decreases as the support stiffens (not stated)",
               ", ".join(f"{w:g}: {fmt(m, 7)}" for w, m in max_x), NOT_STATED)
+    for ws in (31.6, 100.0):  # several attractors coexist there (the runs above show one)
+        note_safely(rec, lambda ws=ws: attractor_note(
+            ctx, base.replace(omega_s=ws), f"omega_s = {ws:g}: attractors reached from other "
+            "initial conditions (the paper states none; the row above follows (0, 0) only)",
+            ic_grid(ctx.setting("coexisting attractors", "grid"))))

@@ -7,7 +7,7 @@ import math
 import numpy as np
 
 from ...presets import preset
-from ..core import DIFFERS, agree_if, figure, fmt, period_text
+from ..core import DIFFERS, agree_if, figure, fmt, lyapunov_text, period_text
 from ._common import IC, JUST_AFTER, method_text
 
 
@@ -43,6 +43,45 @@ def branch(ds, sweep="up"):
     order = np.argsort(vals)
     return (vals[order], np.asarray(per.values)[order].astype(int),
             np.asarray(con.values)[order].astype(int))
+
+
+def lambda1_at(ds, v, sweep="up", with_period=False) -> str:
+    """:func:`lyapunov_text` of the diagram's point nearest ``v`` in sweep ``sweep``."""
+    if "lambda1" not in ds or not math.isfinite(v):
+        return "lambda1 not computed"
+    par = ds.attrs.get("swept_param") or ds.attrs.get("param")
+    sel = {par: float(v)}
+    if "sweep" in ds["lambda1"].dims:
+        from ...plot.bifurcation import sweep_names
+        sweeps = sweep_names(ds)
+        sel["sweep"] = sweeps.index(sweep) if sweep in sweeps else 0
+    return lyapunov_text(ds, with_period=with_period, **sel)
+
+
+def motion_counts(ds, sweep, period) -> str:
+    """How lambda1 classifies the non-periodic values of one sweep (``period`` from
+    :func:`branch`, sorted by value): chaotic / within the errors of 0 / contracting."""
+    if "lambda1" not in ds:
+        return "lambda1 not computed"
+    from ...analysis.stability import CHAOTIC, N_SIGMA
+    par = ds.attrs.get("swept_param") or ds.attrs.get("param")
+    lam, err, mot = (ds[k] for k in ("lambda1", "lambda1_stderr", "motion"))
+    if "sweep" in lam.dims:
+        from ...plot.bifurcation import sweep_names
+        sweeps = sweep_names(ds)
+        k = sweeps.index(sweep) if sweep in sweeps else 0
+        lam, err, mot = (a.isel(sweep=k) for a in (lam, err, mot))
+    order = np.argsort(np.asarray(ds[par].values, dtype=float))
+    lam, err, mot = (np.asarray(a.values)[order] for a in (lam, err, mot))
+    z = period == 0
+    chaotic = int(np.sum(z & (mot == CHAOTIC)))
+    near0 = int(np.sum(z & (np.abs(lam) <= N_SIGMA * err)))
+    neg = int(np.sum(z & (lam < -N_SIGMA * err)))
+    run = longest_run(z & (mot == CHAOTIC))
+    return (f"lambda1 of the {int(z.sum())} non-periodic values: > {N_SIGMA:g} errors above 0 "
+            f"(chaotic) at {chaotic}, within {N_SIGMA:g} errors of 0 (quasi-periodic or a long "
+            f"transient) at {near0}, below 0 (a transient or a long period) at {neg}; longest run "
+            f"of chaotic values {run}; lambda1 over the recorded periods per value")
 
 
 def grazing_then_chaos(values, period, contact):
@@ -95,6 +134,8 @@ def point_in_diagram(rec, ds, param, at, want, where):
         v, got[sweep], _ = value_at(values, period, con, at)
     txt = f"at {param} = {fmt(v, 5)}: " + ", ".join(f"{s} sweep {period_text(q)}"
                                                    for s, q in got.items())
+    if want == 0 or 0 in got.values():  # a claim of chaos, or a sweep without a period
+        txt += " (" + "; ".join(f"{s}: {lambda1_at(ds, v, s)}" for s in got) + ")"
     claim = f"diagram at {param} = {at}: {period_text(want)} ({where})"
     settled = {s: q for s, q in got.items() if q >= 0}  # a not-settled sweep is no attractor
     if len(set(settled.values())) <= 1:
@@ -116,19 +157,24 @@ def _grazing_checks(rec, ds, param, lo, hi, sweep="up"):
     g, c, c_any = grazing_then_chaos(values, period, con)
     rng = hi - lo
     rec.check(f"{sweep} sweep: no chaos before contact (the free oscillator is linear)",
-              f"first chaotic {param} = {fmt(c_any, 5)}, first contact {param} = {fmt(g, 5)}",
+              f"first chaotic {param} = {fmt(c_any, 5)}, first contact {param} = {fmt(g, 5)}"
+              + (f"; at {param} = {fmt(c_any, 5)}: {lambda1_at(ds, c_any, sweep)}"
+                 if math.isfinite(c_any) else ""),
               agree_if(math.isfinite(g) and (not math.isfinite(c_any) or c_any >= g)))
     rec.check(f"{sweep} sweep: chaos appears just after grazing "
               f"(within {JUST_AFTER:.0%} of the range)",
               f"grazing at {param} = {fmt(g, 5)}, chaos from {fmt(c, 5)} "
-              f"(gap {fmt(c - g, 3)}, limit {fmt(JUST_AFTER * rng, 3)})",
+              f"(gap {fmt(c - g, 3)}, limit {fmt(JUST_AFTER * rng, 3)})"
+              + (f"; at {param} = {fmt(c, 5)}: {lambda1_at(ds, c, sweep)}" if math.isfinite(c)
+                 else ""),
               agree_if(math.isfinite(c) and math.isfinite(g) and 0 <= c - g <= JUST_AFTER * rng))
     run = longest_run(period == 0)
     step = (values[-1] - values[0]) / max(values.size - 1, 1)
     rec.check("the response is irregular over a range of the parameter",
               f"{int(np.sum(period == 0))} of {values.size} values not periodic"
               f"{f', {n} not settled' if (n := int(np.sum(period < 0))) else ''}; longest run "
-              f"{run} values ({fmt(run * step, 3)} wide)", agree_if(run >= 3))
+              f"{run} values ({fmt(run * step, 3)} wide); {motion_counts(ds, sweep, period)}",
+              agree_if(run >= 3))
     return values, period, con
 
 

@@ -8,8 +8,9 @@ import numpy as np
 
 from ...presets import preset
 from ..access import number, value
-from ..core import DIFFERS, agree_if, figure, fmt, period_text, verdict_period
-from ._common import (EXPLORE_ICS, gap, method_text, point_summary, run_poincare, settle_text,
+from ..core import DIFFERS, agree_if, figure, fmt, lyapunov_text, period_text, verdict_period
+from ._common import (EXPLORE_ICS, attractor_note, find_orbit, gap, ic_grid, method_text,
+                      note_safely, orbit_text, point_summary, run_poincare, settle_text,
                       try_exact)
 from .fig09_11_bifurcation import branch
 
@@ -27,10 +28,15 @@ def _point_figure(ctx, rec, fid, name, changes, claimed_period, title, contact_c
           else f"exact model not available ({err})")
     got = int(value(ds, "period"))
     v = verdict_period(claimed_period, got)
+    lyap = ""
+    if claimed_period == 0 or got == 0:  # a claim of chaos: lambda1 over the recorded periods
+        lyap = f"; {lyapunov_text(ds, with_period=False)}"
+        if exact is not None:
+            ev += f" ({lyapunov_text(exact, with_period=False)})"
     if v == DIFFERS:
         ev += "; " + explore(ctx, p, claimed_period)
     rec.check(f"{title}: {period_text(claimed_period)}",
-              f"{period_text(got)} (max X = {fmt(value(ds, 'max_X'), 5)})", v, ev)
+              f"{period_text(got)} (max X = {fmt(value(ds, 'max_X'), 5)}){lyap}", v, ev)
     if contact_claim is not None:
         text, want_contact = contact_claim
         con = int(value(ds, "contact"))
@@ -126,8 +132,67 @@ def fig10a(ctx, rec):
 
 @figure("fig10b", "Table 3, omega = 0.92", "chaotic: the orbit reaches the support")
 def fig10b(ctx, rec):
-    _point_figure(ctx, rec, "fig10b", "table3", {"omega": 0.92}, 0, "omega = 0.92",
-                  ("the system reaches the support (contact)", 1))
+    p, _ = _point_figure(ctx, rec, "fig10b", "table3", {"omega": 0.92}, 0, "omega = 0.92",
+                         ("the system reaches the support (contact)", 1))
+    note_safely(rec, lambda: attractor_note(
+        ctx, p, "Coexisting attractors at omega = 0.92 (not in the paper)",
+        ic_grid(ctx.setting("coexisting attractors", "grid"))))
+    note_safely(rec, lambda: coexistence_range(ctx, p))
+
+
+def coexistence_range(ctx, p) -> str:
+    """Where the period-3 orbit of Fig. 10a and the chaotic attractor of Fig. 10b coexist (exact
+    model): the period-3 orbit continued in omega by Newton shooting from the Fig. 10a orbit
+    (stable while all |mu| < 1), and the chaotic attractor followed by a down sweep from (0, 0)
+    (chaotic while lambda1 > 3 errors)."""
+    from ...analysis.bifurcation import bifurcation_diagram
+    from ...analysis.stability import CHAOTIC
+    g = "fig10b: coexistence range"
+    lo, hi, step, transient, record = (ctx.setting(g, k) for k in (
+        "omega from", "omega to", "omega step", "transient", "record"))
+    values = np.round(lo + step * np.arange(int(round((hi - lo) / step)) + 1), 10)
+    # the period-3 orbit, continued up and down from omega = 0.91 (Fig. 10a)
+    start = run_poincare(ctx, p.replace(omega=0.91), method="exact", transient=transient,
+                         record=60)
+    seed = (float(start["X"].values[-1]), float(start["V"].values[-1]))
+    stable, last = {}, {}
+    for side in (values[values >= 0.91], values[values < 0.91][::-1]):
+        x, v = seed
+        for om in side:
+            o = find_orbit(p.replace(omega=float(om)), 3, x, v)
+            if o.attrs.get("status") != "converged" or o.sizes.get("point") != 3:
+                break
+            x, v = float(o["X_section"].values[0]), float(o["V_section"].values[0])
+            stable[float(om)] = bool(o["stable"])
+            last[float(om)] = o
+    p3 = sorted(om for om, s in stable.items() if s)
+    # the chaotic attractor, by a down sweep (each value from the state of the previous one)
+    ds = bifurcation_diagram(p, "omega", values, sweep="down", transient=transient, record=record,
+                             method="exact", x0=0.0, v0=0.0, workers=ctx.workers)
+    om = np.asarray(ds["omega"].values, dtype=float)
+    mot = np.asarray(ds["motion"].values).reshape(-1, om.size)[0]
+    chaos = om[mot == CHAOTIC]
+    both = [w for w in p3 if w in set(chaos.tolist())]
+    txt = (f"omega range of the coexistence (exact model, omega = {fmt(lo)} .. {fmt(hi)} in steps "
+           f"of {fmt(step)}): a stable period-3 orbit (continued from Fig. 10a's by Newton "
+           f"shooting) exists for omega = {fmt(p3[0], 5)} .. {fmt(p3[-1], 5)}" if p3 else
+           "omega range of the coexistence: no stable period-3 orbit found by continuation")
+    if p3:
+        o_hi = last[p3[-1]]
+        txt += (f" (largest |mu| = {fmt(np.max(o_hi['multiplier_abs'].values), 4)} at "
+                f"{fmt(p3[-1], 5)}; Newton shooting finds no period-3 orbit at "
+                f"{fmt(p3[-1] + step, 5)}" if p3[-1] + step <= hi + 1e-12 else ")")
+        txt += ")" if p3[-1] + step <= hi + 1e-12 else ""
+    txt += (f"; a down sweep from (0, 0) stays chaotic (lambda1 > 3 errors) for omega = "
+            f"{fmt(chaos.min(), 5)} .. {fmt(chaos.max(), 5)} ({chaos.size} of {om.size} values, "
+            f"transient {transient}, {record} recorded)" if chaos.size else
+            "; the down sweep finds no chaotic value")
+    if both:
+        txt += (f"; both attractors coexist for omega = {fmt(min(both), 5)} .. "
+                f"{fmt(max(both), 5)} ({len(both)} grid values)")
+    else:
+        txt += "; no value where both were found"
+    return txt
 
 
 @figure("fig12a", "Table 4, F0 = 0.225", "period-4 orbit")

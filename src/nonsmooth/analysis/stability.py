@@ -1,0 +1,484 @@
+"""Stability and chaos of any model: Lyapunov spectra (Benettin) and periodic orbits, stable or
+unstable, by Newton shooting with Floquet multipliers.
+
+Both rest on the tangent kernel (``integrate.hybrid.advance_tangent``, driven through
+:mod:`nonsmooth.tangent`): tangent vectors follow the variational equation of each mode (the
+model's Jacobian; the mode's propagator in closed form for the exact method's linear modes)
+and jump by the saltation matrix at every switch, reset (impact) and stick/slip transition, so
+the numbers are the derivatives of the non-smooth flow, not of a smoothed substitute.
+
+Tangent space: the state u (n components) and the continuous memory of the method (the
+smoothed support model's eq. 13a entry velocity): N = n + n_cm. Lyapunov exponents are those
+of the n state perturbations; Floquet multipliers are the eigenvalues of the monodromy of the
+section point's active coordinates: u, and the memory slots the orbit reads before rewriting
+them (the entry velocity counts only when the section point lies inside Sigma_alpha).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numba as nb
+import numpy as np
+import xarray as xr
+
+from .. import status as st
+from ..errors import IntegrationError, ParameterError
+from ..integrate.contract import ST_H, ST_MODE
+from ..integrate.hybrid import advance_tangent
+from ..io import provenance_attrs
+from ..kernels import mode_holds, output_buffers, run
+from ..models.base import KERNEL_GENERIC
+from ..simulate import check_float, check_int, start_trajectory
+from ..tangent import TangentSetup, period_map
+
+#: Lyapunov verdicts (CF flag values of ``lyapunov_class``).
+PERIODIC, QUASI_PERIODIC, CHAOTIC, NOT_SETTLED = 1, 2, 3, 4
+VERDICTS = {0: "unknown", PERIODIC: "periodic", QUASI_PERIODIC: "quasi-periodic",
+            CHAOTIC: "chaotic", NOT_SETTLED: "not settled"}
+#: A nonzero lambda1 must exceed this many standard errors.
+N_SIGMA = 3.0
+#: |mu| within this of 1 is neutral (e.g. the time shift of an unforced limit cycle).
+NEUTRAL = 1e-6
+ALIGN = 100  # periods of the transient that also carry the tangent vectors (alignment)
+_SLICE = 2000  # periods per kernel call (progress and Ctrl-C between calls)
+
+
+def classify(lambda1: float, error: float, period: int = 0) -> int:
+    """Verdict from lambda1 (per unit time) with its standard error and the detected period
+    (> 0 periodic, 0 none, -1 not settled; None: not looked for): periodic when a period was
+    found (then lambda1 < 0 beyond its error, or a neutral orbit); chaotic when lambda1 > 0
+    beyond ``N_SIGMA`` errors; quasi-periodic when lambda1 is within ``N_SIGMA`` errors of 0;
+    for lambda1 < 0 beyond its error: periodic when no period was looked for (a contracting
+    attractor of the period map is a periodic orbit), else not settled (no period found: a
+    periodic orbit longer than the period search, or a transient)."""
+    if period is not None and period > 0:
+        return PERIODIC
+    if not (math.isfinite(lambda1) and math.isfinite(error)):
+        return NOT_SETTLED if lambda1 == -math.inf else 0
+    if lambda1 > N_SIGMA * error:
+        return CHAOTIC
+    if abs(lambda1) <= N_SIGMA * error:
+        return QUASI_PERIODIC
+    return PERIODIC if period is None else NOT_SETTLED
+
+
+def block_error(logs: np.ndarray, blocks: int) -> np.ndarray:
+    """Standard error of the mean of per-period growth logs (periods x n) from ``blocks``
+    consecutive block means (per period)."""
+    n = logs.shape[0]
+    b = max(2, min(blocks, n))
+    size = n // b
+    if size < 1:
+        return np.full(logs.shape[1], np.nan)
+    means = logs[: b * size].reshape(b, size, -1).mean(axis=1)
+    with np.errstate(invalid="ignore"):
+        return means.std(axis=0, ddof=1) / math.sqrt(b)
+
+
+def _checkpoints(periods: int, n_max: int = 500) -> np.ndarray:
+    """Period counts at which the running estimate is stored (about n_max, geometric)."""
+    pts = np.unique(np.geomspace(1, periods, min(n_max, periods)).astype(np.int64))
+    return pts
+
+
+def lyapunov(params, *, periods: int = 10000, transient: int = 1000, x0: float = 0.0,
+             v0: float = 0.0, method: str = "smooth", rtol: float = 1e-8, atol: float = 1e-10,
+             blocks: int = 20, progress=None) -> xr.Dataset:
+    """Lyapunov spectrum of the trajectory from (x0, v0), any model.
+
+    The trajectory first runs ``transient`` forcing periods (the last ``ALIGN`` of them with
+    the tangent vectors, so that they are aligned when recording starts); then the n tangent
+    vectors of the state are propagated over ``periods`` periods (variational equations and
+    saltation matrices, :mod:`nonsmooth.tangent`) and re-orthonormalised by QR at every
+    period end (Benettin's method): lambda_i = (1 / (periods T)) sum_k log R_ii(k).
+
+    Returns a Dataset with ``exponent`` (per unit time) and ``exponent_per_period`` (times T)
+    over the coordinate ``i`` = 1..n, ``stderr`` (standard error of ``exponent`` from
+    ``blocks`` block means; a strongly correlated chaotic signal needs long blocks), the
+    ``running`` estimate at ~500 checkpoints (``period``), ``lambda1``, ``lambda1_stderr``,
+    ``exponent_sum`` and ``lyapunov_class`` (1 periodic: lambda1 < 0 beyond its error, 2
+    quasi-periodic: within its error of 0, 3 chaotic: > 0 beyond it; :func:`classify`).
+    Exponents of -inf mean that perturbations are annihilated (sticking, impacts with
+    r = 0)."""
+    params, solver, p, opts, state = start_trajectory(params, x0, v0, method, rtol, atol,
+                                                      "eq13")
+    periods = check_int("periods", periods, 1)
+    transient = check_int("transient", transient, 0)
+    blocks = check_int("blocks", blocks, 2)
+    setup = TangentSetup(solver)
+    n, N = setup.n, setup.N
+    T = params.period
+    total = transient + periods
+    done = 0
+
+    def tick(k):
+        nonlocal done
+        done += k
+        if progress is not None:
+            progress(done, total)
+
+    plain = max(0, transient - ALIGN)
+    while done < plain:  # transient without tangent vectors
+        k = min(_SLICE, plain - done)
+        bufs = output_buffers(0)
+        code = run(KERNEL_GENERIC, setup.fns, p, opts, state, 1, k, 0, *bufs)
+        if code != st.OK:
+            raise IntegrationError(f"lyapunov: transient failed after {done} periods: "
+                                   f"{st.message(code)}")
+        tick(k)
+    Y = np.ascontiguousarray(np.eye(N)[:, :n])
+    align = transient - plain
+    if align:
+        code, _ = setup.run(p, state, 0, Y, np.zeros((0, n)), transient=align)
+        if code != st.OK:
+            raise IntegrationError(f"lyapunov: transient failed after {done} periods: "
+                                   f"{st.message(code)}")
+        tick(align)
+    logs = np.empty((periods, n))
+    k0 = 0
+    while k0 < periods:
+        k = min(_SLICE, periods - k0)
+        code, _ = setup.run(p, state, k, Y, logs[k0:k0 + k])
+        if code != st.OK:
+            raise IntegrationError(f"lyapunov: integration failed after {transient + k0} "
+                                   f"periods: {st.message(code)}")
+        k0 += k
+        tick(k)
+    with np.errstate(invalid="ignore"):
+        per_period = logs.mean(axis=0)
+        err = block_error(logs, blocks) / T
+        cum = np.cumsum(logs, axis=0)
+    expo = per_period / T
+    pts = _checkpoints(periods)
+    running = cum[pts - 1] / (pts[:, None] * T)
+    l1, e1 = float(expo[0]), float(err[0])
+    cls = classify(l1, e1, None)
+    i = np.arange(1, n + 1)
+    ds = xr.Dataset(
+        {
+            "exponent": ("i", expo, {"long_name": "Lyapunov exponent", "units": "1/s"}),
+            "exponent_per_period": ("i", per_period, {
+                "long_name": "Lyapunov exponent per forcing period (exponent x T)",
+                "units": "1"}),
+            "stderr": ("i", err, {"long_name": f"standard error of the exponent "
+                                               f"({max(2, min(blocks, periods))} block means)",
+                                  "units": "1/s"}),
+            "running": (("period", "i"), running, {
+                "long_name": "running estimate of the exponents", "units": "1/s"}),
+            "lambda1": ((), l1, {"long_name": "largest Lyapunov exponent", "units": "1/s"}),
+            "lambda1_stderr": ((), e1, {"long_name": "standard error of lambda1",
+                                        "units": "1/s"}),
+            "exponent_sum": ((), float(expo.sum()), {
+                "long_name": "sum of the exponents (time average of the divergence, saltation "
+                             "included)", "units": "1/s"}),
+            "lyapunov_class": ((), np.int8(cls), {
+                "long_name": "verdict from lambda1 and its error",
+                "flag_values": np.arange(5, dtype=np.int8),
+                "flag_meanings": "unknown periodic quasi_periodic chaotic not_settled"}),
+        },
+        coords={"i": ("i", i, {"long_name": "exponent index (largest first)"}),
+                "period": ("period", pts, {"long_name": "recorded forcing periods"})},
+        attrs=provenance_attrs(params, solver, analysis="lyapunov", periods=periods,
+                               transient=transient, x0=float(x0), v0=float(v0), blocks=blocks,
+                               forcing_period=T, state_names=" ".join(params.model.state_names),
+                               verdict=VERDICTS[cls]),
+    )
+    return ds
+
+
+# ---- periodic orbits by Newton shooting -------------------------------------------------------
+def _section_state(setup, p, z, template):
+    """Kernel state at section point z: the template's mode and memory flags if that mode still
+    holds there, else classified by the model (mode -1)."""
+    s = setup.state_of(z, template)
+    if s[ST_MODE] >= 0 and not mode_holds(KERNEL_GENERIC, setup.fns, p, setup.opts, s):
+        s[ST_MODE] = -1.0
+    return s
+
+
+def periodic_orbit(params, *, k: int = 1, x0: float = 0.0, v0: float = 0.0,
+                   method: str = "exact", transient: int = 0, tol: float = 1e-10,
+                   max_iter: int = 40, rtol: float = 1e-10, atol: float = 1e-12,
+                   samples_per_period: int = 200) -> xr.Dataset:
+    """A k-periodic orbit (fixed point of the k-fold stroboscopic map), stable or unstable, by
+    Newton shooting from (x0, v0) (after ``transient`` periods).
+
+    Newton's iteration on F(z) = P^k(z) - z with the monodromy M = dP^k/dz from the tangent
+    kernel (F' = M - I): quadratic convergence; a step that does not reduce |F| is halved up
+    to 12 times (damped Newton). Converged when |F| <= tol (1 + |z|).
+
+    Returns a Dataset: the section points ``X_section``, ``V_section`` (k of them, ``point``),
+    the Floquet multipliers ``multiplier_real`` / ``multiplier_imag`` and ``multiplier_abs``
+    (largest modulus first), ``stable`` (all |mu| < 1), ``max_X``, ``min_X`` over the orbit
+    (interior extrema), ``contact_fraction`` (fraction of the orbit's samples in the model's
+    contact modes), the orbit itself (``X``, ``V``, ``mode`` over ``t``, one period k T at
+    ``samples_per_period`` per period), and attrs ``status`` ("converged", "max_iter",
+    "diverged", "integration failed: ...", "singular"), ``iterations`` and ``residual``.
+    Bad input raises one-line ParameterErrors; a failed search is a status, not an error."""
+    params, solver, p, opts, state = start_trajectory(params, x0, v0, method, rtol, atol,
+                                                      "eq13")
+    k = check_int("k", k, 1)
+    transient = check_int("transient", transient, 0)
+    max_iter = check_int("max_iter", max_iter, 1)
+    spp = check_int("samples_per_period", samples_per_period, 1)
+    tol = check_float("tol", tol)
+    if not tol > 0:
+        raise ParameterError(f"tol: must be > 0, got {tol}")
+    setup = TangentSetup(solver)
+    N = setup.N
+    if transient:
+        code = run(KERNEL_GENERIC, setup.fns, p, opts, state, 1, transient, 0,
+                   *output_buffers(0))
+        if code != st.OK:
+            raise IntegrationError(f"periodic_orbit: transient failed: {st.message(code)}")
+    else:  # classify the start (mode and memory) without moving
+        run(KERNEL_GENERIC, setup.fns, p, opts, state, 1, 0, 0, *output_buffers(0))
+    z = setup.z_of(state)
+    template = state
+    status = "max_iter"
+    res = math.inf
+    M = np.full((N, N), np.nan)
+    it = 0
+    history = []
+    for it in range(1, max_iter + 1):
+        s0 = _section_state(setup, p, z, template)
+        s1, M, code, _ = period_map(setup, p, s0, k)
+        if code != st.OK:
+            status = f"integration failed: {st.message(code)}"
+            M = np.full((N, N), np.nan)
+            break
+        F = setup.z_of(s1) - z
+        res = float(np.linalg.norm(F))
+        history.append(res)
+        if res <= tol * (1.0 + float(np.linalg.norm(z))):
+            status = "converged"
+            template = s0
+            break
+        act = _active(M, setup.n)
+        try:
+            dz = np.zeros(N)
+            dz[act] = np.linalg.solve(M[np.ix_(act, act)] - np.eye(int(act.sum())), -F[act])
+            dz[~act] = F[~act]  # memory not read before it is rewritten: take the mapped value
+        except np.linalg.LinAlgError:
+            status = "singular"
+            break
+        if not np.all(np.isfinite(dz)):
+            status = "diverged"
+            break
+        lam = 1.0
+        accepted = False
+        for _ in range(13):  # damped step: accept the first that reduces |F|
+            zt = z + lam * dz
+            st_t = _section_state(setup, p, zt, s0)
+            s1t, _, code_t, _ = _map_only(setup, p, st_t, k)
+            if code_t == st.OK:
+                rt = float(np.linalg.norm(setup.z_of(s1t) - zt))
+                if rt < res:
+                    accepted = True
+                    break
+            lam *= 0.5
+        if not accepted:
+            status = "diverged"
+            break
+        template = st_t
+        z = zt
+        if not np.all(np.isfinite(z)) or float(np.linalg.norm(z)) > 1e12:
+            status = "diverged"
+            break
+    act = _active(M, setup.n) if np.all(np.isfinite(M)) else np.ones(N, bool)
+    Ma = M[np.ix_(act, act)]
+    mu = np.linalg.eigvals(Ma) if np.all(np.isfinite(Ma)) else np.full(len(Ma), np.nan + 0j)
+    order = np.argsort(-np.abs(mu), kind="stable")
+    mu = mu[order]
+    converged = status == "converged"
+    # the orbit itself, for plotting and its extremes
+    n_s = k * spp
+    bufs = output_buffers(n_s)
+    s_orbit = _section_state(setup, p, z, template)
+    run(KERNEL_GENERIC, setup.fns, p, opts, s_orbit, 1, 0, 0, *output_buffers(0))  # classify
+    start = s_orbit.copy()
+    code = run(KERNEL_GENERIC, setup.fns, p, opts, s_orbit, spp, 0, n_s, *bufs)
+    Xs, Vs, R, Mk, Xmax, Xmin = bufs
+    if code != st.OK:
+        Xs[:] = np.nan
+    X = np.concatenate([[start[0]], Xs])
+    V = np.concatenate([[start[1]], Vs])
+    R = np.concatenate([[int(start[ST_MODE])], R]).astype(np.int8)
+    T = params.period
+    t = np.arange(n_s + 1) * (T / spp)
+    cmask = params.model.contact_modes
+    in_contact = ((1 << R[1:].astype(np.int64)) & cmask) != 0 if cmask else np.zeros(n_s, bool)
+    absmu = np.abs(mu)
+    stable = bool(converged and np.all(absmu < 1.0 - NEUTRAL))
+    neutral = bool(converged and not stable and np.all(absmu <= 1.0 + NEUTRAL))
+    ds = xr.Dataset(
+        {
+            "X_section": ("point", X[::spp][:k], {"long_name": "X at the section t = jT",
+                                                  "units": "1"}),
+            "V_section": ("point", V[::spp][:k], {"long_name": "V at the section t = jT",
+                                                  "units": "1/s"}),
+            "multiplier_real": ("multiplier", mu.real, {"long_name": "Floquet multiplier, real "
+                                                                     "part", "units": "1"}),
+            "multiplier_imag": ("multiplier", mu.imag, {"long_name": "Floquet multiplier, "
+                                                                     "imaginary part",
+                                                        "units": "1"}),
+            "multiplier_abs": ("multiplier", absmu, {"long_name": "modulus of the Floquet "
+                                                                  "multiplier", "units": "1"}),
+            "monodromy": (("row", "col"), M, {"long_name": "monodromy matrix dP^k/dz of the "
+                                                           "section point z", "units": "1"}),
+            "stable": ((), np.int8(stable), {"long_name": "1: every multiplier inside the unit "
+                                                          "circle by more than 1e-6 "
+                                                          "(asymptotically stable)",
+                                             "flag_values": np.array([0, 1], np.int8),
+                                             "flag_meanings": "not_stable stable"}),
+            "max_X": ((), float(np.max(Xmax)) if code == st.OK else np.nan,
+                      {"long_name": "largest X over the orbit (interior extrema included)",
+                       "units": "1"}),
+            "min_X": ((), float(np.min(Xmin)) if code == st.OK else np.nan,
+                      {"long_name": "smallest X over the orbit (interior extrema included)",
+                       "units": "1"}),
+            "contact_fraction": ((), float(in_contact.mean()), {
+                "long_name": "fraction of the orbit's samples in contact modes", "units": "1"}),
+            "X": ("t", X, {"long_name": params.model.state_long_names[0]
+                           if params.model.state_long_names else "X", "units": "1"}),
+            "V": ("t", V, {"long_name": "velocity dX/dt", "units": "1/s"}),
+            "mode": ("t", R, {"long_name": "mode at t",
+                              "flag_values": np.arange(len(params.model.mode_names),
+                                                       dtype=np.int8),
+                              "flag_meanings": " ".join(params.model.mode_names)}),
+        },
+        coords={"point": np.arange(k), "multiplier": np.arange(1, len(mu) + 1),
+                "t": ("t", t, {"long_name": "time from the section point", "units": "s"})},
+        attrs=provenance_attrs(params, solver, analysis="periodic_orbit", k=k, x0=float(x0),
+                               v0=float(v0), transient=transient, tol=tol,
+                               status=status, iterations=it, residual=res,
+                               converged=int(converged),
+                               verdict=("stable" if stable else "neutral" if neutral
+                                        else "unstable") if converged else "not found",
+                               forcing_period=T),
+    )
+    return ds
+
+
+def _active(M, n):
+    """Coordinates of the section point that the map depends on: the state, and the memory
+    slots that the state after k periods depends on (a memory value that is rewritten before
+    it is read, e.g. an entry velocity at a section point outside its band, is not a
+    coordinate of the map; keeping it would add a spurious multiplier 1 or 0)."""
+    act = np.ones(M.shape[0], bool)
+    for q in range(n, M.shape[0]):
+        act[q] = bool(np.any(M[:n, q] != 0.0))
+    return act
+
+
+def _map_only(setup, p, state, k):
+    """The k-fold map without the tangent (for line-search trials)."""
+    s = state.copy()
+    code = run(KERNEL_GENERIC, setup.fns, p, setup.opts, s, 1, k, 0, *output_buffers(0))
+    return s, None, code, None
+
+
+# ---- lambda1 of many points (sweeps) ----------------------------------------------------------
+@nb.njit(cache=True, parallel=True)
+def _lambda1_many(fns, P, opts, states, align, periods, N, cmi, logs, status):
+    """One tangent vector per point over ``align`` + ``periods`` periods (normalised each
+    period): logs[i, k] = log growth of recorded period k (after the ``align`` periods that
+    turn the vector into the leading direction); status[i] the kernel status."""
+    for i in nb.prange(P.shape[0]):
+        Y = np.zeros((N, 1))
+        Y[0, 0] = 1.0
+        Y[1, 0] = 1.0
+        L = np.empty((periods, 1))
+        X = np.empty(periods)
+        V = np.empty(periods)
+        R = np.empty(periods, np.int8)
+        M = np.empty(periods, np.uint8)
+        Xa = np.empty(periods)
+        Xb = np.empty(periods)
+        status[i] = advance_tangent(fns, P[i], opts, states[i], 1, align, periods, X, V, R, M,
+                                    Xa, Xb, Y, L, cmi, 1)
+        for k in range(periods):
+            logs[i, k] = L[k, 0]
+
+
+def lambda1_points(P, solver, states, periods: int, *, blocks: int = 10, workers=None):
+    """lambda1 (per unit time) and its standard error for many points at once: rows of packed
+    parameters ``P`` from kernel ``states`` (copied; a specialised kernel's state is
+    re-classified for the generic kernel, mode -1), ``periods`` periods each after
+    max(20, periods // 4) periods of alignment, one tangent vector (all local cores).
+    Returns (lambda1, stderr, status) arrays."""
+    from ..sweep import threads
+    setup = TangentSetup(solver)
+    P = np.array(np.atleast_2d(P), dtype=np.float64, order="C")  # writable, contiguous
+    S = np.array(states, dtype=np.float64, copy=True).reshape(P.shape[0], -1)
+    if solver.code != KERNEL_GENERIC:
+        S[:, ST_MODE] = -1.0
+        S[:, ST_H] = 0.0
+    logs = np.zeros((P.shape[0], periods))
+    status = np.zeros(P.shape[0], np.int64)
+    with threads(workers):
+        _lambda1_many(setup.fns, P, setup.opts, S, max(20, periods // 4), periods, setup.N,
+                      setup.cmi, logs, status)
+    om = P[:, solver.model.index[solver.model.omega]]
+    T = 2.0 * np.pi / om
+    with np.errstate(invalid="ignore"):
+        lam = logs.mean(axis=1) / T
+        err = np.array([block_error(logs[i][:, None], blocks)[0] for i in range(len(P))]) / T
+    bad = status != st.OK
+    lam[bad] = np.nan
+    err[bad] = np.nan
+    return lam, err, status
+
+
+def classify_points(lam, err, period) -> np.ndarray:
+    """:func:`classify` over arrays (0 where lambda1 is NaN and no period was found)."""
+    out = np.zeros(np.shape(period), np.int8)
+    for idx in np.ndindex(out.shape):
+        pr = int(np.asarray(period)[idx])
+        if pr == -1:
+            out[idx] = NOT_SETTLED
+        else:
+            out[idx] = classify(float(np.asarray(lam)[idx]), float(np.asarray(err)[idx]), pr)
+    return out
+
+
+def motion_attrs() -> dict:
+    """CF flag attributes of a ``motion`` variable (:data:`VERDICTS`)."""
+    from ..io import flag_attrs
+    return flag_attrs([VERDICTS[k].replace("-", "_") for k in sorted(VERDICTS)],
+                      dtype=np.int8,
+                      long_name="motion: periodic (a period found), chaotic (lambda1 > 0 beyond "
+                                f"{N_SIGMA:g} standard errors), quasi-periodic (no period, "
+                                "lambda1 within its error of 0), not settled")
+
+
+def wants_lyapunov(flag, solver) -> bool:
+    """Whether a sweep computes lambda1: ``flag`` True/False, or None (the default) = yes
+    where tangent dynamics exist (all models and methods except the smoothed support model
+    with the eq. 12 transition fields)."""
+    if flag is None:
+        return not (solver.model.name == "support" and solver.method == "smooth"
+                    and solver.transition != "eq13")
+    return bool(flag)
+
+
+def lyapunov_variables(P, solver, states, periods: int, period, dims) -> dict:
+    """Dataset variables ``lambda1``, ``lambda1_stderr``, ``motion`` for points (rows of
+    ``P``, kernel ``states`` on their attractors, detected ``period`` of shape ``dims``
+    sizes): :func:`lambda1_points` over ``periods`` periods, then :func:`classify_points`."""
+    period = np.asarray(period)
+    lam, err, _ = lambda1_points(P, solver, states, periods)
+    lam = lam.reshape(period.shape)
+    err = err.reshape(period.shape)
+    motion = classify_points(lam, err, period)
+    if not dims:
+        lam, err, motion = float(lam[0]), float(err[0]), np.int8(motion[0])
+    return {
+        "lambda1": (dims, lam, {"long_name": "largest Lyapunov exponent (tangent dynamics with "
+                                             "saltation matrices)", "units": "1/s",
+                                "periods": periods}),
+        "lambda1_stderr": (dims, err, {"long_name": "standard error of lambda1 (10 block "
+                                                    "means)", "units": "1/s"}),
+        "motion": (dims, motion, motion_attrs()),
+    }
