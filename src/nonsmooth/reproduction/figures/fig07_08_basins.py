@@ -8,7 +8,7 @@ import numpy as np
 
 from ...presets import preset
 from ..core import DIFFERS, NOT_STATED, agree_if, figure, fmt, period_text
-from ._common import BASIN_WINDOW, gap, method_text
+from ._common import BASIN_WINDOW, find_orbit, gap, method_text, note_safely, orbit_text
 from .fig06_resonance import jump_width, resonance
 
 
@@ -184,3 +184,18 @@ def fig8(ctx, rec):
               agree_if(len(per) == 2 and all(q > 0 for q in per)))
     rec.check("one with contact, one without", f"contact flags {sorted(con)}",
               agree_if(sorted(con) == [0, 1]))
+    note_safely(rec, lambda: saddle_note(p))
+
+
+#: A start from which Newton shooting reaches the saddle period-1 orbit between the two
+#: attractors (found by scanning starts on a grid; every start that converges there gives the
+#: same orbit).
+SADDLE_START = (-1.5, 0.25)
+
+
+def saddle_note(p) -> str:
+    """The unstable period-1 orbit between the two attractors (not in the paper), by Newton
+    shooting on the exact model: its multipliers straddle the unit circle."""
+    o = find_orbit(p, 1, *SADDLE_START, method="exact")
+    return ("Saddle orbit between the two coexisting attractors (not in the paper; exact model, "
+            f"Newton shooting from (X, V) = {SADDLE_START}): " + orbit_text(o))
