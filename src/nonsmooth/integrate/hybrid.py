@@ -264,7 +264,7 @@ def _cf_state(MC, mode, om, y0, z0, C, S, hs, u1, f1):
 
 
 # ---- tangent (variational) dynamics ---------------------------------------------------------
-@nb.njit(cache=True, fastmath=_FM)
+@nb.njit(cache=True, inline="always", fastmath=_FM)
 def _rk_tangent(jacobian, mode, tau, C, S, h, om, n, u, k0, k1, k2, k3, k4, k5, pp, mem, Y, W, KY,
                 J, us, cmi):
     """Propagate the tangent Y (rows: u, then the continuous memory slots ``cmi``) through the
@@ -314,7 +314,7 @@ def _rk_tangent(jacobian, mode, tau, C, S, h, om, n, u, k0, k1, k2, k3, k4, k5, 
                             + b3 * KY[3, r, c] + b4 * KY[4, r, c] + b5 * KY[5, r, c])
 
 
-@nb.njit(cache=True, fastmath=_FM)
+@nb.njit(cache=True, inline="always", fastmath=_FM)
 def _cf_tangent(MC, mode, om, h, Y):
     """Y <- Phi(h) Y for a closed-form mode: Phi = exp(A h), A = [[0, 1], [-k, -c]] (the
     mode's homogeneous propagator); memory rows are unchanged."""
