@@ -1,0 +1,369 @@
+"""Continuation of periodic orbits in one parameter, through folds, with their stability and
+special points (fold, period doubling, Neimark-Sacker, grazing), for every model.
+
+A k-periodic orbit is a fixed point z of the k-fold stroboscopic map P^k(z; lam) (z: the section
+point, :mod:`nonsmooth.tangent`). Pseudo-arclength continuation follows the curve
+F(z, lam) = P^k(z; lam) - z = 0 in (z, lam): the tangent t spans the null space of
+[dF/dz, dF/dlam] = [M - I, dP/dlam] (M the monodromy from the tangent kernel, saltation matrices
+included; dP/dlam by central differences of the map), the predictor steps ds along t, and
+Newton's corrector solves F = 0 with t . (y - y_pred) = 0, so the branch turns at folds and
+goes on along the unstable part. The step adapts to the corrector's iterations.
+
+Special points are sign changes of test functions between consecutive points, located by the
+Illinois method on the arclength (each trial point corrected onto the branch):
+
+* fold (saddle-node): the lam-component of the tangent (a multiplier crosses +1);
+* period doubling: det(M + I) (a multiplier crosses -1);
+* Neimark-Sacker: mu_1 mu_2 - 1 over the complex pair (a pair crosses the unit circle);
+* grazing: max X - contact level (the model's ``contact_level``; the orbit first touches the
+  switching surface): the multipliers may jump there, as the contact sequence changes.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import xarray as xr
+
+from .. import status as st
+from ..errors import ParameterError
+from ..io import provenance_attrs
+from ..kernels import output_buffers, run
+from ..models.base import KERNEL_GENERIC
+from ..params import check_param_name
+from ..simulate import check_float, check_int, start_trajectory
+from ..tangent import TangentSetup, period_map
+from .stability import NEUTRAL, _active, _section_state, periodic_orbit
+
+#: Special-point types (CF flag values of ``special``).
+FOLD, PERIOD_DOUBLING, NEIMARK_SACKER, GRAZING = 1, 2, 3, 4
+SPECIAL_NAMES = {0: "none", FOLD: "fold", PERIOD_DOUBLING: "period_doubling",
+                 NEIMARK_SACKER: "neimark_sacker", GRAZING: "grazing"}
+LOCATE_TOL = 1e-10  # special points: |delta lam| of the bracketing pair
+_SAMPLES = 100  # samples per period of the orbit for max/min X and the contact fraction
+
+
+class _Branch:
+    """The map, its derivatives and the corrector at one parameter index."""
+
+    def __init__(self, setup: TangentSetup, p0: np.ndarray, index: int, k: int, tol: float,
+                 level):
+        self.setup, self.p0, self.index, self.k, self.tol, self.level = (setup, p0, index, k,
+                                                                         tol, level)
+        self.template = None
+
+    def p(self, lam):
+        p = self.p0.copy()
+        p[self.index] = lam
+        return p
+
+    def evaluate(self, z, lam):
+        """F, M (N x N), dF/dlam, the end state and the per-period buffers at (z, lam), or
+        None when a trajectory fails."""
+        s0 = _section_state(self.setup, self.p(lam), z, self.template)
+        s1, M, code, bufs = period_map(self.setup, self.p(lam), s0, self.k)
+        if code != st.OK:
+            return None
+        h = 1e-7 * max(1.0, abs(lam))
+        ends = []
+        for sg in (1.0, -1.0):
+            s = _section_state(self.setup, self.p(lam + sg * h), z, s0)
+            if run(KERNEL_GENERIC, self.setup.fns, self.p(lam + sg * h), self.setup.opts, s, 1,
+                   self.k, 0, *output_buffers(0)) != st.OK:
+                return None
+            ends.append(self.setup.z_of(s))
+        Fl = (ends[0] - ends[1]) / (2.0 * h)
+        return self.setup.z_of(s1) - z, M, Fl, s0, bufs
+
+    def correct(self, y_pred, t, max_iter=12):
+        """Newton's corrector onto F = 0 in the hyperplane t . (y - y_pred) = 0. Returns
+        (y, evaluation, iterations) or None."""
+        y = y_pred.copy()
+        N = self.setup.N
+        for it in range(1, max_iter + 1):
+            ev = self.evaluate(y[:N], y[N])
+            if ev is None:
+                return None
+            F, M, Fl, s0, _ = ev
+            act = _active(M, self.setup.n)
+            ia = np.flatnonzero(act)
+            J = np.hstack([(M - np.eye(N))[np.ix_(ia, ia)], Fl[ia, None]])
+            tt = np.concatenate([t[ia], t[N:]])
+            A = np.vstack([J, tt[None, :]])
+            rhs = -np.concatenate([F[ia], [tt @ (np.concatenate([y[ia], y[N:]])
+                                                 - np.concatenate([y_pred[ia], y_pred[N:]]))]])
+            try:
+                d = np.linalg.solve(A, rhs)
+            except np.linalg.LinAlgError:
+                return None
+            if not np.all(np.isfinite(d)):
+                return None
+            y[ia] += d[:-1]
+            y[N] += d[-1]
+            ina = np.flatnonzero(~act)
+            y[ina] += F[ina]  # memory rewritten before it is read: its mapped value
+            small = np.linalg.norm(F[ia]) <= self.tol * (1.0 + np.linalg.norm(y[:N]))
+            if small and np.linalg.norm(d) <= 1e3 * self.tol * (1.0 + np.linalg.norm(y)):
+                ev = self.evaluate(y[:N], y[N])
+                if ev is None:
+                    return None
+                self.template = ev[3]
+                return y, ev, it
+        return None
+
+    def tangent(self, ev, t_prev):
+        """Unit tangent at a corrected point, oriented along t_prev."""
+        F, M, Fl, s0, _ = ev
+        N = self.setup.N
+        act = _active(M, self.setup.n)
+        ia = np.flatnonzero(act)
+        J = np.hstack([(M - np.eye(N))[np.ix_(ia, ia)], Fl[ia, None]])
+        tp = np.concatenate([t_prev[ia], t_prev[N:]])
+        try:
+            v = np.linalg.solve(np.vstack([J, tp[None, :]]), np.r_[np.zeros(len(ia)), 1.0])
+        except np.linalg.LinAlgError:
+            v = tp.copy()
+        v /= np.linalg.norm(v)
+        t = np.zeros(N + 1)
+        t[ia] = v[:-1]
+        t[N] = v[-1]
+        return t
+
+    def features(self, y, ev, t):
+        """Multipliers, test functions and orbit features of a corrected point."""
+        F, M, Fl, s0, bufs = ev
+        act = _active(M, self.setup.n)
+        Ma = M[np.ix_(act, act)]
+        mu = np.linalg.eigvals(Ma)
+        mu = mu[np.argsort(-np.abs(mu), kind="stable")]
+        n_s = self.k * _SAMPLES
+        ob = output_buffers(n_s)
+        s = s0.copy()
+        code = run(KERNEL_GENERIC, self.setup.fns, self.p(y[-1]), self.setup.opts, s, _SAMPLES,
+                   0, n_s, *ob)
+        Xs, Vs, R, Mk, Xmax, Xmin = ob
+        cm = self.setup.model.contact_modes
+        contact = float(np.mean(((1 << R.astype(np.int64)) & cm) != 0)) if cm else 0.0
+        mx = float(np.max(Xmax)) if code == st.OK else math.nan
+        mn = float(np.min(Xmin)) if code == st.OK else math.nan
+        ns_test = 1.0  # prod_{i<j} (mu_i mu_j - 1): real; zero when a pair's product is 1
+        for i in range(len(mu)):
+            for j in range(i + 1, len(mu)):
+                ns_test *= mu[i] * mu[j] - 1.0
+        ns_test = float(np.real(ns_test))
+        tests = {FOLD: t[-1],
+                 PERIOD_DOUBLING: float(np.real(np.prod(mu + 1.0))),
+                 NEIMARK_SACKER: ns_test,
+                 GRAZING: mx - self.level if self.level is not None else math.nan}
+        sec = (bufs[0][:self.k], bufs[1][:self.k])
+        return dict(mu=mu, max_X=mx, min_X=mn, contact=contact, tests=tests, section=sec)
+
+
+def continuation(params, param: str, *, k: int = 1, x0: float = 0.0, v0: float = 0.0,
+                 transient: int = 0, direction: str = "up", step: float = 0.01,
+                 max_step: float | None = None, bounds=None, max_points: int = 400,
+                 method: str = "exact", tol: float = 1e-10, rtol: float = 1e-10,
+                 atol: float = 1e-12) -> xr.Dataset:
+    """Follow a branch of k-periodic orbits in ``param`` from ``params``.
+
+    The first point is the orbit Newton's shooting finds from (x0, v0) (after ``transient``
+    periods) at ``params``; the branch then runs ``direction`` ("up": ``param`` increasing
+    at first, "down") with arclength steps starting at ``step`` (in the units of the
+    parameter and the section point, adapted between step/64 and ``max_step``, default
+    10 x step) until it leaves ``bounds`` (lo, hi), reaches ``max_points`` or cannot continue.
+
+    Returns a Dataset over ``point``: the parameter, the section points (``X_section``,
+    ``V_section`` over ``point``, ``j``), the Floquet multipliers (``multiplier_real/imag/abs``),
+    ``stable``, ``max_X``, ``min_X``, ``contact_fraction``, and the located ``special`` points
+    over ``special`` (``special_type`` with CF flags, ``special_<param>``, the multiplier
+    nearest the crossing and the point index after which it lies); attrs ``status`` (why the
+    branch ended)."""
+    params, solver, p0, opts, state = start_trajectory(params, x0, v0, method, rtol, atol,
+                                                       "eq13")
+    if not isinstance(param, str):
+        raise ParameterError(f"param: expected a parameter name, got {param!r}")
+    param = check_param_name(param, params)
+    k = check_int("k", k, 1)
+    max_points = check_int("max_points", max_points, 2)
+    step = check_float("step", step)
+    if not step > 0:
+        raise ParameterError(f"step: must be > 0, got {step}")
+    max_step = 10.0 * step if max_step is None else check_float("max_step", max_step)
+    if direction not in ("up", "down"):
+        raise ParameterError(f"direction: expected 'up' or 'down', got {direction!r}")
+    lam0 = float(getattr(params, param))
+    if bounds is None:
+        bounds = (-math.inf, math.inf)
+    lo, hi = (check_float("bounds", b) if math.isfinite(b) else b for b in bounds)
+    if not lo <= lam0 <= hi:
+        raise ParameterError(f"bounds: ({lo:g}, {hi:g}) exclude the start {param} = {lam0:g}")
+    setup = TangentSetup(solver)
+    index = params.model.index[param]
+    level = params.model.contact_level(params) if params.model.contact_level else None
+    br = _Branch(setup, p0, index, k, tol, level)
+
+    orb = periodic_orbit(params, k=k, x0=x0, v0=v0, method=method, transient=transient, tol=tol,
+                         rtol=rtol, atol=atol, samples_per_period=1)
+    if orb.attrs["status"] != "converged":
+        raise ParameterError(f"start: no period-{k} orbit found from (x0, v0) = ({x0:g}, {v0:g}) "
+                             f"at {param} = {lam0:g} ({orb.attrs['status']}); try another start")
+    N = setup.N
+    s_start = _section_state(setup, p0, setup.z_of(_start_state(setup, p0, orb, state)), state)
+    br.template = s_start
+    y = np.r_[setup.z_of(s_start), lam0]
+    ev = br.evaluate(y[:N], y[N])
+    t = np.zeros(N + 1)
+    t[N] = 1.0 if direction == "up" else -1.0
+    t = br.tangent(ev, t)
+    if t[N] * (1.0 if direction == "up" else -1.0) < 0:
+        t = -t
+    pts = [(y, br.features(y, ev, t))]
+    specials = []
+    ds = step
+    status = "max_points"
+    while len(pts) < max_points:
+        y0, f0 = pts[-1]
+        got = None
+        while ds >= step / 64:
+            got = br.correct(y0 + ds * t, t)
+            if got is not None:
+                break
+            ds *= 0.5
+        if got is None:
+            status = "cannot continue (the corrector fails even at step / 64)"
+            break
+        y1, ev1, iters = got
+        t1 = br.tangent(ev1, t)
+        f1 = br.features(y1, ev1, t1)
+        for typ in (FOLD, PERIOD_DOUBLING, NEIMARK_SACKER, GRAZING):
+            a, b = f0["tests"][typ], f1["tests"][typ]
+            if math.isfinite(a) and math.isfinite(b) and a * b < 0:
+                sp = _locate(br, typ, y0, t, ds, a, b)
+                if sp is not None and _confirmed(typ, sp[1]):
+                    specials.append((typ, len(pts) - 1, *sp))
+        pts.append((y1, f1))
+        t = t1
+        if not lo <= y1[N] <= hi:
+            status = "left the bounds"
+            break
+        ds = min(max_step, ds * 1.5) if iters <= 3 else (ds * 0.5 if iters > 6 else ds)
+    return _dataset(params, solver, param, k, pts, specials, status, N, direction, bounds)
+
+
+def _confirmed(typ, mu) -> bool:
+    """A located Neimark-Sacker point must be a complex pair on the unit circle (a real pair
+    with product 1, a neutral saddle, also zeroes its test function)."""
+    if typ == NEIMARK_SACKER:
+        return abs(mu.imag) > 1e-9 and abs(abs(mu) - 1.0) < 1e-4
+    return True
+
+
+def _start_state(setup, p, orb, state):
+    """The kernel state at the converged section point of ``orb`` (mode classified)."""
+    z = np.zeros(setup.N)
+    z[0] = float(orb.X_section[0])
+    z[1] = float(orb.V_section[0])
+    s = setup.state_of(z, state)
+    s[3] = -1.0
+    run(KERNEL_GENERIC, setup.fns, p, setup.opts, s, 1, 0, 0, *output_buffers(0))
+    return s
+
+
+def _locate(br, typ, y0, t0, ds, a, b):
+    """Illinois on the arclength s in (0, ds) from y0 along t0 for a zero of test ``typ``;
+    returns (lam, multiplier nearest the crossing, y) or None."""
+    sa, sb = 0.0, ds
+    fa, fb = a, b
+    side = 0
+    best = None
+    for _ in range(60):
+        s = (sa * fb - sb * fa) / (fb - fa) if fb != fa else 0.5 * (sa + sb)
+        if not sa < s < sb:
+            s = 0.5 * (sa + sb)
+        got = br.correct(y0 + s * t0, t0)
+        if got is None:
+            return None
+        y, ev, _ = got
+        t = br.tangent(ev, t0)
+        f = br.features(y, ev, t)
+        fs = f["tests"][typ]
+        best = (y, f)
+        if fs * fa > 0:
+            sa, fa = s, fs
+            if side == -1:
+                fb *= 0.5
+            side = -1
+        else:
+            sb, fb = s, fs
+            if side == 1:
+                fa *= 0.5
+            side = 1
+        lam_a = y0[-1] + sa * t0[-1]
+        lam_b = y0[-1] + sb * t0[-1]
+        if abs(lam_b - lam_a) <= LOCATE_TOL * max(1.0, abs(y[-1])) or fs == 0.0:
+            break
+    y, f = best
+    mu = f["mu"]
+    target = {FOLD: 1.0, PERIOD_DOUBLING: -1.0}.get(typ)
+    if target is not None:
+        m = mu[np.argmin(np.abs(mu - target))]
+    elif typ == NEIMARK_SACKER:
+        m = mu[np.argmin(np.abs(np.abs(mu) - 1.0) + (np.abs(mu.imag) <= 1e-12))]
+    else:
+        m = mu[0]
+    return float(y[-1]), complex(m), y
+
+
+def _dataset(params, solver, param, k, pts, specials, status, N, direction, bounds):
+    from ..io import flag_attrs
+    lam = np.array([y[-1] for y, _ in pts])
+    mus = [f["mu"] for _, f in pts]
+    nm = max(len(m) for m in mus)
+    MU = np.full((len(pts), nm), np.nan + 0j)
+    for i, m in enumerate(mus):
+        MU[i, :len(m)] = m
+    absmu = np.abs(MU)
+    stable = np.array([bool(np.all(np.abs(m) < 1.0 - NEUTRAL)) for m in mus], np.int8)
+    XS = np.array([f["section"][0] for _, f in pts])
+    VS = np.array([f["section"][1] for _, f in pts])
+    spec = params.model.param(param)
+    sp_type = np.array([s[0] for s in specials], np.int8)
+    sp_lam = np.array([s[2] for s in specials], float)
+    sp_mu = np.array([s[3] for s in specials], complex)
+    sp_after = np.array([s[1] for s in specials], np.int64)
+    ds = xr.Dataset(
+        {
+            param: ("point", lam, {"long_name": spec.long_name, "units": spec.units}),
+            "X_section": (("point", "j"), XS, {"long_name": "section points X(jT)",
+                                              "units": "1"}),
+            "V_section": (("point", "j"), VS, {"long_name": "section points V(jT)",
+                                              "units": "1/s"}),
+            "multiplier_real": (("point", "multiplier"), MU.real, {"units": "1"}),
+            "multiplier_imag": (("point", "multiplier"), MU.imag, {"units": "1"}),
+            "multiplier_abs": (("point", "multiplier"), absmu, {"units": "1"}),
+            "stable": ("point", stable, flag_attrs(("not_stable", "stable"), dtype=np.int8,
+                                                   long_name="every |mu| < 1 - 1e-6")),
+            "max_X": ("point", np.array([f["max_X"] for _, f in pts]),
+                      {"long_name": "largest X over the orbit", "units": "1"}),
+            "min_X": ("point", np.array([f["min_X"] for _, f in pts]),
+                      {"long_name": "smallest X over the orbit", "units": "1"}),
+            "contact_fraction": ("point", np.array([f["contact"] for _, f in pts]), {
+                "long_name": "fraction of the orbit's samples in contact modes", "units": "1"}),
+            "special_type": ("special", sp_type, flag_attrs(
+                [SPECIAL_NAMES[i] for i in sorted(SPECIAL_NAMES)], dtype=np.int8,
+                long_name="type of the special point")),
+            f"special_{param}": ("special", sp_lam, {"long_name": f"{param} at the special "
+                                                                  f"point", "units": spec.units}),
+            "special_multiplier_real": ("special", sp_mu.real, {"units": "1"}),
+            "special_multiplier_imag": ("special", sp_mu.imag, {"units": "1"}),
+            "special_after_point": ("special", sp_after, {
+                "long_name": "the special point lies between this point and the next"}),
+        },
+        coords={"point": np.arange(len(pts)), "j": np.arange(k),
+                "multiplier": np.arange(1, nm + 1), "special": np.arange(len(specials))},
+        attrs=provenance_attrs(params, solver, swept=(param,), analysis="continuation",
+                               param=param, k=k, direction=direction, status=status,
+                               bounds_low=float(bounds[0]), bounds_high=float(bounds[1])),
+    )
+    return ds

@@ -1,0 +1,106 @@
+"""Continuation of periodic orbits (``analysis.continuation``), against oracles: the closed-form
+grazing of the contact-free orbit, multipliers +1 / -1 at located folds / period doublings,
+the unstable branch between the folds of Fig. 6a, and ``periodic_orbit`` at branch points."""
+
+import math
+
+import numpy as np
+import pytest
+from scipy.optimize import brentq
+
+import nonsmooth as ns
+from nonsmooth.analysis.continuation import (FOLD, GRAZING, PERIOD_DOUBLING, continuation)
+
+
+def free_amplitude(p, omega, F0):
+    """Amplitude of the contact-free period-1 orbit (the linear oscillator's)."""
+    return F0 / math.sqrt((p.omega0 ** 2 - omega ** 2) ** 2 + (p.xi * omega) ** 2)
+
+
+def specials(ds, typ):
+    sel = ds.special_type.values == typ
+    name = f"special_{ds.attrs['param']}"
+    mu = ds.special_multiplier_real.values + 1j * ds.special_multiplier_imag.values
+    return ds[name].values[sel], mu[sel]
+
+
+@pytest.fixture(scope="module")
+def fig6a_branch():
+    return continuation(ns.preset("fig6a").replace(omega=0.5), "omega", bounds=(0.5, 1.6),
+                        step=0.01, max_points=300)
+
+
+def test_grazing_in_omega_matches_closed_form():
+    p = ns.preset("table3").replace(omega=0.6)
+    ds = continuation(p, "omega", bounds=(0.5, 0.9), step=0.01, max_points=60)
+    w, _ = specials(ds, GRAZING)
+    wg = brentq(lambda om: free_amplitude(p, om, p.F0) - 1.0, 0.6, 0.99, xtol=1e-15)
+    assert len(w) >= 1 and abs(w[0] - wg) <= 1e-9
+
+
+def test_grazing_in_F0_matches_closed_form():
+    p = ns.preset("table3").replace(omega=0.7, F0=0.2)
+    ds = continuation(p, "F0", bounds=(0.1, 0.8), step=0.02, max_points=60)
+    f, _ = specials(ds, GRAZING)
+    fg = math.sqrt((p.omega0 ** 2 - p.omega ** 2) ** 2 + (p.xi * p.omega) ** 2)  # A = 1
+    assert len(f) >= 1 and abs(f[0] - fg) <= 1e-9
+
+
+def test_fig6a_folds_and_unstable_branch(fig6a_branch):
+    ds = fig6a_branch
+    w, mu = specials(ds, FOLD)
+    assert len(w) == 2
+    assert np.all(np.abs(mu - 1.0) <= 1e-6)  # a multiplier through +1 at each fold
+    w_b, w_c = sorted(w)
+    # the sweep-based jump points of the same resonance curve (resonance_curve, exact):
+    # omega_b in [1.05508, 1.05516], omega_c in [1.19305, 1.19313] (a sweep lingers near the
+    # ghost of the fold, so its upper jump is at most a few 1e-5 late)
+    assert 1.05507 <= w_b <= 1.05516 and 1.1930 <= w_c <= 1.19313
+    # between the folds (after turning at omega_c, before turning at omega_b) the branch is
+    # unstable: one multiplier outside the unit circle
+    om = ds.omega.values
+    after = ds.special_after_point.values[ds.special_type.values == FOLD]  # (omega_c, omega_b)
+    middle = [i for i in range(after[0] + 1, after[1] + 1) if w_b + 1e-3 < om[i] < w_c - 1e-3]
+    assert len(middle) >= 3 and all(ds.multiplier_abs.values[i, 0] > 1.0 for i in middle)
+    assert all(ds.stable.values[i] == 0 for i in middle)
+    # and the contact onset omega_a (grazing) below both
+    g, _ = specials(ds, GRAZING)
+    assert 0.94023 <= g.min() <= 0.94032
+
+
+def test_branch_points_are_periodic_orbits(fig6a_branch):
+    ds = fig6a_branch
+    p = ns.preset("fig6a")
+    upper_fold = int(ds.special_after_point.values[ds.special_type.values == FOLD][0])
+    for i in (5, upper_fold + 3):  # a stable point, and one on the unstable branch
+        om = float(ds.omega[i])
+        orb = ns.periodic_orbit(p.replace(omega=om), x0=float(ds.X_section[i, 0]),
+                                v0=float(ds.V_section[i, 0]), max_iter=3)
+        assert orb.attrs["status"] == "converged" and orb.attrs["iterations"] <= 2
+        assert float(orb.X_section[0]) == pytest.approx(float(ds.X_section[i, 0]), abs=1e-8)
+        assert np.allclose(np.sort(orb.multiplier_abs.values),
+                           np.sort(ds.multiplier_abs.values[i]), atol=1e-7)
+
+
+def test_period_doubling_multiplier_is_minus_one():
+    p = ns.preset("table3").replace(omega=0.6)
+    ds = continuation(p, "omega", bounds=(0.5, 1.0), step=0.01, max_points=80)
+    w, mu = specials(ds, PERIOD_DOUBLING)
+    # just after grazing (0.83083) and at 0.96935
+    assert len(w) == 2 and abs(w[1] - 0.96935) < 1e-4
+    assert np.all(np.abs(mu - (-1.0)) <= 1e-6)
+
+
+@pytest.mark.parametrize("kw, field", [(dict(step=0.0), "step"),
+                                       (dict(bounds=(0.95, 1.0)), "bounds"),
+                                       (dict(k=0), "k"),
+                                       (dict(direction="sideways"), "direction")])
+def test_bad_input_one_line(kw, field):
+    with pytest.raises(ns.ParameterError) as e:
+        continuation(ns.preset("fig7"), "omega", **kw)
+    assert str(e.value).startswith(field) and "\n" not in str(e.value)
+
+
+def test_bad_start_one_line():
+    with pytest.raises(ns.ParameterError, match="^start: no period-1 orbit"):
+        continuation(ns.preset("fig7"), "omega", x0=1e8, v0=1e8, max_points=3)
