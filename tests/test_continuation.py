@@ -104,3 +104,26 @@ def test_bad_input_one_line(kw, field):
 def test_bad_start_one_line():
     with pytest.raises(ns.ParameterError, match="^start: no period-1 orbit"):
         continuation(ns.preset("fig7"), "omega", x0=1e8, v0=1e8, max_points=3)
+
+
+def test_branch_switching_at_period_doubling():
+    """From the PD of the period-1 branch (table3, omega = 0.96935) the doubled branch starts
+    next to it: genuine period-2 orbits (two distinct section points), each a fixed point of
+    the 2-fold map that periodic_orbit confirms."""
+    p = ns.preset("table3").replace(omega=0.6)
+    ds = continuation(p, "omega", bounds=(0.5, 1.0), step=0.01, max_points=80)
+    i = int(np.flatnonzero(ds.special_type.values == PERIOD_DOUBLING)[-1])
+    w_pd = float(ds.special_omega[i])
+    d2 = continuation(p, "omega", start=(ds, i), bounds=(0.9, 1.0), step=0.002, max_points=20)
+    assert d2.attrs["k"] == 2 and d2.sizes["point"] >= 5
+    assert abs(float(d2.omega[0]) - w_pd) <= 2e-4
+    assert np.all(np.abs(d2.X_section.values[:, 0] - d2.X_section.values[:, 1]) > 1e-4)
+    j = 3
+    orb = ns.periodic_orbit(p.replace(omega=float(d2.omega[j])), k=2,
+                            x0=float(d2.X_section[j, 0]), v0=float(d2.V_section[j, 0]),
+                            max_iter=3)
+    assert orb.attrs["status"] == "converged"
+    assert float(orb.X_section[1]) == pytest.approx(float(d2.X_section[j, 1]), abs=1e-8)
+    with pytest.raises(ns.ParameterError, match="^start: special point"):
+        continuation(p, "omega", start=(ds, int(np.flatnonzero(ds.special_type.values
+                                                                 == GRAZING)[0])))

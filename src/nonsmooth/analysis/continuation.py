@@ -17,6 +17,9 @@ Illinois method on the arclength (each trial point corrected onto the branch):
 * Neimark-Sacker: mu_1 mu_2 - 1 over the complex pair (a pair crosses the unit circle);
 * grazing: max X - contact level (the model's ``contact_level``; the orbit first touches the
   switching surface): the multipliers may jump there, as the contact sequence changes.
+
+``special_jump`` says when the multipliers jumped across a located point instead of passing
+through the unit circle (a non-smooth transition: the test function changed sign by a jump).
 """
 
 from __future__ import annotations
@@ -41,6 +44,11 @@ FOLD, PERIOD_DOUBLING, NEIMARK_SACKER, GRAZING = 1, 2, 3, 4
 SPECIAL_NAMES = {0: "none", FOLD: "fold", PERIOD_DOUBLING: "period_doubling",
                  NEIMARK_SACKER: "neimark_sacker", GRAZING: "grazing"}
 LOCATE_TOL = 1e-10  # special points: |delta lam| of the bracketing pair
+#: A located fold / PD / NS whose critical multiplier is farther than this from +1 / -1 / the
+#: unit circle was crossed by a jump of the multipliers (a non-smooth, border-collision
+#: transition, e.g. at a grazing), not through the circle.
+JUMP_TOL = 1e-4
+MIN_STEP = 1.0 / 4096  # smallest arclength step, relative to ``step``
 _SAMPLES = 100  # samples per period of the orbit for max/min X and the contact fraction
 
 
@@ -160,17 +168,21 @@ class _Branch:
         return dict(mu=mu, max_X=mx, min_X=mn, contact=contact, tests=tests, section=sec)
 
 
-def continuation(params, param: str, *, k: int = 1, x0: float = 0.0, v0: float = 0.0,
-                 transient: int = 0, direction: str = "up", step: float = 0.01,
+def continuation(params, param: str, *, start=None, k: int = 1, x0: float = 0.0,
+                 v0: float = 0.0, transient: int = 0, direction: str = "up", step: float = 0.01,
                  max_step: float | None = None, bounds=None, max_points: int = 400,
                  method: str = "exact", tol: float = 1e-10, rtol: float = 1e-10,
                  atol: float = 1e-12) -> xr.Dataset:
     """Follow a branch of k-periodic orbits in ``param`` from ``params``.
 
     The first point is the orbit Newton's shooting finds from (x0, v0) (after ``transient``
-    periods) at ``params``; the branch then runs ``direction`` ("up": ``param`` increasing
+    periods) at ``params``; with ``start=(branch, i)``, a period-doubling point ``i`` of an
+    earlier branch Dataset instead (branch switching: the 2k-periodic orbit born there, found
+    from the period-k orbit displaced along the eigenvector of the multiplier -1 on the side of
+    the PD where it exists; ``k`` is then the earlier branch's k doubled and ``direction`` is
+    away from the PD). The branch then runs ``direction`` ("up": ``param`` increasing
     at first, "down") with arclength steps starting at ``step`` (in the units of the
-    parameter and the section point, adapted between step/64 and ``max_step``, default
+    parameter and the section point, adapted between step x MIN_STEP and ``max_step``, default
     10 x step) until it leaves ``bounds`` (lo, hi), reaches ``max_points`` or cannot continue.
 
     Returns a Dataset over ``point``: the parameter, the section points (``X_section``,
@@ -196,18 +208,28 @@ def continuation(params, param: str, *, k: int = 1, x0: float = 0.0, v0: float =
     if bounds is None:
         bounds = (-math.inf, math.inf)
     lo, hi = (check_float("bounds", b) if math.isfinite(b) else b for b in bounds)
-    if not lo <= lam0 <= hi:
+    if start is None and not lo <= lam0 <= hi:
         raise ParameterError(f"bounds: ({lo:g}, {hi:g}) exclude the start {param} = {lam0:g}")
     setup = TangentSetup(solver)
     index = params.model.index[param]
     level = params.model.contact_level(params) if params.model.contact_level else None
     br = _Branch(setup, p0, index, k, tol, level)
 
-    orb = periodic_orbit(params, k=k, x0=x0, v0=v0, method=method, transient=transient, tol=tol,
-                         rtol=rtol, atol=atol, samples_per_period=1)
-    if orb.attrs["status"] != "converged":
-        raise ParameterError(f"start: no period-{k} orbit found from (x0, v0) = ({x0:g}, {v0:g}) "
-                             f"at {param} = {lam0:g} ({orb.attrs['status']}); try another start")
+    if start is not None:
+        orb, lam0, k, direction = _doubled_orbit(params, param, start, method, tol, rtol, atol)
+        if not lo <= lam0 <= hi:
+            raise ParameterError(f"bounds: ({lo:g}, {hi:g}) exclude the period doubling at "
+                                 f"{param} = {lam0:g}")
+        params = params.replace(**{param: lam0})
+        p0 = params.pack()
+        br = _Branch(setup, p0, index, k, tol, level)
+    else:
+        orb = periodic_orbit(params, k=k, x0=x0, v0=v0, method=method, transient=transient,
+                             tol=tol, rtol=rtol, atol=atol, samples_per_period=1)
+        if orb.attrs["status"] != "converged":
+            raise ParameterError(f"start: no period-{k} orbit found from (x0, v0) = ({x0:g}, "
+                                 f"{v0:g}) at {param} = {lam0:g} ({orb.attrs['status']}); try "
+                                 f"another start")
     N = setup.N
     s_start = _section_state(setup, p0, setup.z_of(_start_state(setup, p0, orb, state)), state)
     br.template = s_start
@@ -225,13 +247,13 @@ def continuation(params, param: str, *, k: int = 1, x0: float = 0.0, v0: float =
     while len(pts) < max_points:
         y0, f0 = pts[-1]
         got = None
-        while ds >= step / 64:
+        while ds >= step * MIN_STEP:
             got = br.correct(y0 + ds * t, t)
             if got is not None:
                 break
             ds *= 0.5
         if got is None:
-            status = "cannot continue (the corrector fails even at step / 64)"
+            status = f"cannot continue (the corrector fails even at step x {MIN_STEP:g})"
             break
         y1, ev1, iters = got
         t1 = br.tangent(ev1, t)
@@ -249,6 +271,49 @@ def continuation(params, param: str, *, k: int = 1, x0: float = 0.0, v0: float =
             break
         ds = min(max_step, ds * 1.5) if iters <= 3 else (ds * 0.5 if iters > 6 else ds)
     return _dataset(params, solver, param, k, pts, specials, status, N, direction, bounds)
+
+
+def _doubled_orbit(params, param, start, method, tol, rtol, atol):
+    """Branch switching at a period doubling: (the 2k orbit's periodic_orbit Dataset, its
+    parameter value, 2k, direction away from the PD)."""
+    try:
+        src, i = start
+        typ = int(src.special_type[i])
+    except (TypeError, ValueError, KeyError, IndexError):
+        raise ParameterError("start: expected (branch Dataset, index of a special point)") from None
+    if typ != PERIOD_DOUBLING:
+        raise ParameterError(f"start: special point {i} is a {SPECIAL_NAMES.get(typ, typ)}, "
+                             f"not a period doubling")
+    if src.attrs.get("param") != param:
+        raise ParameterError(f"start: the branch was continued in {src.attrs.get('param')}, "
+                             f"not in {param}")
+    k = int(src.attrs["k"])
+    lam = float(src[f"special_{param}"][i])
+    z = np.array([float(src.special_X_section[i]), float(src.special_V_section[i])])
+    base = params.replace(**{param: lam})
+    orb = periodic_orbit(base, k=k, x0=z[0], v0=z[1], method=method, tol=tol, rtol=rtol,
+                         atol=atol, samples_per_period=1)
+    M = orb.monodromy.values[:2, :2]
+    w, V = np.linalg.eig(M)
+    v = np.real(V[:, int(np.argmin(np.abs(w + 1.0)))])
+    v /= np.linalg.norm(v)
+    scale = 1.0 + float(np.linalg.norm(z))
+    for dl in (1e-4, 1e-3):
+        for sg in (1.0, -1.0):
+            lam_t = lam + sg * dl * max(1.0, abs(lam))
+            for amp in (1e-2, 3e-2, 1e-1):
+                zt = z + amp * scale * v
+                o2 = periodic_orbit(params.replace(**{param: lam_t}), k=2 * k, x0=zt[0],
+                                    v0=zt[1], method=method, tol=tol, rtol=rtol, atol=atol,
+                                    samples_per_period=1)
+                if o2.attrs["status"] != "converged":
+                    continue
+                xs, vs = o2.X_section.values, o2.V_section.values
+                spread = math.hypot(xs[0] - xs[k], vs[0] - vs[k])
+                if spread > 1e-6 * scale:  # a genuine 2k orbit, not the k orbit again
+                    return o2, lam_t, 2 * k, "up" if sg > 0 else "down"
+    raise ParameterError(f"start: no period-{2 * k} orbit found near the period doubling at "
+                         f"{param} = {lam:.10g}")
 
 
 def _confirmed(typ, mu) -> bool:
@@ -277,6 +342,7 @@ def _locate(br, typ, y0, t0, ds, a, b):
     fa, fb = a, b
     side = 0
     best = None
+    mu_sides = [None, None]  # multipliers at the last point found on each side
     for _ in range(60):
         s = (sa * fb - sb * fa) / (fb - fa) if fb != fa else 0.5 * (sa + sb)
         if not sa < s < sb:
@@ -289,6 +355,7 @@ def _locate(br, typ, y0, t0, ds, a, b):
         f = br.features(y, ev, t)
         fs = f["tests"][typ]
         best = (y, f)
+        mu_sides[0 if fs * fa > 0 else 1] = f["mu"]
         if fs * fa > 0:
             sa, fa = s, fs
             if side == -1:
@@ -312,7 +379,15 @@ def _locate(br, typ, y0, t0, ds, a, b):
         m = mu[np.argmin(np.abs(np.abs(mu) - 1.0) + (np.abs(mu.imag) <= 1e-12))]
     else:
         m = mu[0]
-    return float(y[-1]), complex(m), y
+    if target is not None:
+        jump = abs(m - target) > JUMP_TOL
+    elif typ == NEIMARK_SACKER:
+        jump = abs(abs(m) - 1.0) > JUMP_TOL
+    else:  # grazing: do the multipliers on either side of it differ?
+        a_, b_ = mu_sides
+        jump = (a_ is not None and b_ is not None and len(a_) == len(b_)
+                and float(np.max(np.abs(np.sort_complex(a_) - np.sort_complex(b_)))) > 1e-3)
+    return float(y[-1]), complex(m), y, bool(jump)
 
 
 def _dataset(params, solver, param, k, pts, specials, status, N, direction, bounds):
@@ -332,6 +407,8 @@ def _dataset(params, solver, param, k, pts, specials, status, N, direction, boun
     sp_lam = np.array([s[2] for s in specials], float)
     sp_mu = np.array([s[3] for s in specials], complex)
     sp_after = np.array([s[1] for s in specials], np.int64)
+    sp_z = np.array([s[4][:2] for s in specials]).reshape(len(specials), 2)
+    sp_jump = np.array([s[5] for s in specials], np.int8)
     ds = xr.Dataset(
         {
             param: ("point", lam, {"long_name": spec.long_name, "units": spec.units}),
@@ -357,6 +434,15 @@ def _dataset(params, solver, param, k, pts, specials, status, N, direction, boun
                                                                   f"point", "units": spec.units}),
             "special_multiplier_real": ("special", sp_mu.real, {"units": "1"}),
             "special_multiplier_imag": ("special", sp_mu.imag, {"units": "1"}),
+            "special_X_section": ("special", sp_z[:, 0], {
+                "long_name": "first section point X at the special point", "units": "1"}),
+            "special_V_section": ("special", sp_z[:, 1], {
+                "long_name": "first section point V at the special point", "units": "1/s"}),
+            "special_jump": ("special", sp_jump, flag_attrs(
+                ("through_the_unit_circle", "multipliers_jump"), dtype=np.int8,
+                long_name="1: the multipliers jump across the point (a non-smooth transition, "
+                          "e.g. at a grazing; a fold / PD / NS test changed sign without a "
+                          "multiplier on the unit circle)")),
             "special_after_point": ("special", sp_after, {
                 "long_name": "the special point lies between this point and the next"}),
         },
