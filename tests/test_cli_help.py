@@ -9,7 +9,7 @@ from typer.testing import CliRunner
 from nonsmooth.cli import app
 
 COMMANDS = ["simulate", "presets", "poincare", "bifurcation", "resonance", "basins", "eta-study",
-            "reproduce", "lyapunov", "orbit"]
+            "reproduce", "lyapunov", "orbit", "continue"]
 
 
 @pytest.mark.parametrize("command", COMMANDS)

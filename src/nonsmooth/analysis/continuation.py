@@ -202,12 +202,22 @@ def continuation(params, param: str, *, start=None, k: int = 1, x0: float = 0.0,
     if not step > 0:
         raise ParameterError(f"step: must be > 0, got {step}")
     max_step = 10.0 * step if max_step is None else check_float("max_step", max_step)
+    if not max_step >= step:
+        raise ParameterError(f"max_step: must be >= step = {step:g}, got {max_step:g}")
+    tol = check_float("tol", tol)
+    if not tol > 0:
+        raise ParameterError(f"tol: must be > 0, got {tol}")
     if direction not in ("up", "down"):
         raise ParameterError(f"direction: expected 'up' or 'down', got {direction!r}")
     lam0 = float(getattr(params, param))
     if bounds is None:
         bounds = (-math.inf, math.inf)
-    lo, hi = (check_float("bounds", b) if math.isfinite(b) else b for b in bounds)
+    try:
+        lo, hi = (float(b) for b in bounds)
+    except (TypeError, ValueError):
+        raise ParameterError(f"bounds: expected (low, high), got {bounds!r}") from None
+    if math.isnan(lo) or math.isnan(hi) or not lo < hi:
+        raise ParameterError(f"bounds: expected low < high, got ({lo:g}, {hi:g})")
     if start is None and not lo <= lam0 <= hi:
         raise ParameterError(f"bounds: ({lo:g}, {hi:g}) exclude the start {param} = {lam0:g}")
     setup = TangentSetup(solver)
@@ -387,7 +397,7 @@ def _locate(br, typ, y0, t0, ds, a, b):
         a_, b_ = mu_sides
         jump = (a_ is not None and b_ is not None and len(a_) == len(b_)
                 and float(np.max(np.abs(np.sort_complex(a_) - np.sort_complex(b_)))) > 1e-3)
-    return float(y[-1]), complex(m), y, bool(jump)
+    return float(y[-1]), complex(m), y, bool(jump), f["max_X"]
 
 
 def _dataset(params, solver, param, k, pts, specials, status, N, direction, bounds):
@@ -409,6 +419,7 @@ def _dataset(params, solver, param, k, pts, specials, status, N, direction, boun
     sp_after = np.array([s[1] for s in specials], np.int64)
     sp_z = np.array([s[4][:2] for s in specials]).reshape(len(specials), 2)
     sp_jump = np.array([s[5] for s in specials], np.int8)
+    sp_mx = np.array([s[6] for s in specials], float)
     ds = xr.Dataset(
         {
             param: ("point", lam, {"long_name": spec.long_name, "units": spec.units}),
@@ -438,6 +449,8 @@ def _dataset(params, solver, param, k, pts, specials, status, N, direction, boun
                 "long_name": "first section point X at the special point", "units": "1"}),
             "special_V_section": ("special", sp_z[:, 1], {
                 "long_name": "first section point V at the special point", "units": "1/s"}),
+            "special_max_X": ("special", sp_mx, {"long_name": "largest X over the orbit at "
+                                                              "the special point", "units": "1"}),
             "special_jump": ("special", sp_jump, flag_attrs(
                 ("through_the_unit_circle", "multipliers_jump"), dtype=np.int8,
                 long_name="1: the multipliers jump across the point (a non-smooth transition, "

@@ -23,6 +23,7 @@ from . import reproduce  # noqa: E402,F401
 from . import basins  # noqa: E402,F401
 from . import models  # noqa: E402,F401
 from . import stability  # noqa: E402,F401
+from . import continuation  # noqa: E402,F401
 
 def _terminate(signum, frame):
     raise Terminated()

@@ -36,6 +36,7 @@ _PLOTS = {
     "plot_section_panel": ".reproduce_panels",
     "plot_lyapunov": ".stability",
     "plot_orbit": ".stability",
+    "plot_continuation": ".continuation",
 }
 
 __all__ = ["MODE_COLORS", "MODE_LABELS", "LINE_LABELS", "REGION_COLORS", "REGION_LABELS",

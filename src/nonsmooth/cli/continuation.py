@@ -1,0 +1,129 @@
+"""`nonsmooth continue`: a branch of periodic orbits followed in one parameter (pseudo-arclength
+continuation through folds), with its stability and special points."""
+
+from __future__ import annotations
+
+import math
+from typing import Annotated, Optional
+
+import typer
+
+from ..errors import ParameterError
+from .analyses import V0Opt, X0Opt
+from .app import app
+from .common import (AtolOpt, ModelOpt, OutOpt, PlotOpt, PresetOpt, RtolOpt, SetOpt,
+                     check_outputs, echo_written, load_params, preset_label, resolve_method,
+                     save_outputs)
+from .stability import OrbitMethodOpt, _num, print_table
+
+#: Words for the special-point types (CF flag values of ``special_type``).
+SPECIAL_TEXT = {1: "fold (F)", 2: "period doubling (PD)", 3: "Neimark-Sacker (NS)",
+                4: "grazing (G)"}
+
+
+def _check_bounds(bounds) -> tuple[float, float] | None:
+    if bounds is None:
+        return None
+    lo, hi = (float(b) for b in bounds)
+    for b in (lo, hi):
+        if math.isnan(b):
+            raise ParameterError(f"bounds: expected numbers, got {b}")
+    if not lo < hi:
+        raise ParameterError(f"bounds: empty or reversed range: LO {lo:g} must be < HI {hi:g}")
+    return lo, hi
+
+
+def _multiplier(re: float, im: float) -> str:
+    return f"{re:.6g}" if im == 0 else f"{re:.6g}{im:+.6g}j"
+
+
+@app.command("continue")
+def continue_cmd(
+    param: Annotated[str, typer.Option(
+        "--param", show_default=False, help="the continued parameter, one of the model's "
+                                            "(e.g. omega)")],
+    model: ModelOpt = "support",
+    preset: PresetOpt = None,
+    set_: SetOpt = None,
+    k: Annotated[int, typer.Option("--k", help="period of the orbits in forcing periods")] = 1,
+    x0: X0Opt = 0.0,
+    v0: V0Opt = 0.0,
+    transient: Annotated[int, typer.Option(
+        "--transient", help="forcing periods run from (x0, v0) before the first orbit's "
+                            "Newton search")] = 0,
+    direction: Annotated[str, typer.Option(
+        "--direction", help="up (the parameter increasing at first) or down")] = "up",
+    step: Annotated[float, typer.Option(
+        "--step", help="first arclength step (parameter and section point units)")] = 0.01,
+    max_step: Annotated[Optional[float], typer.Option(
+        "--max-step", show_default=False,
+        help="largest arclength step; default 10 x --step")] = None,
+    bounds: Annotated[Optional[tuple[float, float]], typer.Option(
+        "--bounds", show_default=False,
+        help="stop when the parameter leaves LO HI (must contain the start); default: "
+             "none")] = None,
+    max_points: Annotated[int, typer.Option(
+        "--max-points", help="points on the branch at most")] = 400,
+    tol: Annotated[float, typer.Option(
+        "--tol", help="Newton tolerance of the orbits: |P^k(z) - z| <= tol (1 + |z|)")] = 1e-10,
+    method: OrbitMethodOpt = None,
+    rtol: RtolOpt = 1e-10,
+    atol: AtolOpt = 1e-12,
+    out: OutOpt = None,
+    plot: PlotOpt = None,
+):
+    """Continuation of a branch of k-periodic orbits in --param from the orbit found at the
+    preset's value (Newton shooting from (x0, v0)): pseudo-arclength, through folds, with the
+    Floquet multipliers and stability of every point and the special points located on it
+    (fold, period doubling, Neimark-Sacker, grazing); the branch figure, stable solid,
+    unstable dashed."""
+    from ..analysis.continuation import continuation
+    from ..params import check_param_name
+    from ..simulate import check_float, check_int
+
+    params = load_params(preset, set_, model, "fig6a")
+    if method is None and "exact" in params.model.methods:
+        method = "exact"
+    method = resolve_method(params, method)
+    preset = preset_label(params, preset, "fig6a")
+    param = check_param_name(param, params)
+    check_int("k", k, 1)
+    check_int("transient", transient, 0)
+    check_int("max_points", max_points, 2)
+    if direction not in ("up", "down"):
+        raise ParameterError(f"direction: expected 'up' or 'down', got {direction!r}")
+    if not check_float("step", step) > 0:
+        raise ParameterError(f"step: must be > 0, got {step:g}")
+    if max_step is not None and not check_float("max_step", max_step) >= step:
+        raise ParameterError(f"max_step: must be >= step ({step:g}), got {max_step:g}")
+    bounds = _check_bounds(bounds)
+    lam0 = float(getattr(params, param))
+    if bounds is not None and not bounds[0] <= lam0 <= bounds[1]:
+        raise ParameterError(f"bounds: {bounds[0]:g} ... {bounds[1]:g} exclude the start "
+                             f"{param} = {lam0:g} (set it with --set {param}=VALUE)")
+    check_outputs(out, plot)
+    ds = continuation(params, param, k=k, x0=x0, v0=v0, transient=transient,
+                      direction=direction, step=step, max_step=max_step, bounds=bounds,
+                      max_points=max_points, method=method, tol=tol, rtol=rtol, atol=atol)
+    from ..plot.continuation import plot_continuation
+    save_outputs(ds, preset, out, plot, plot_continuation)
+    lam = ds[param].values
+    stable = ds["stable"].values.astype(bool)
+    typer.echo(f"{preset} ({method}): period-{k} branch in {param}, {lam.size} points from "
+               f"{param} = {lam[0]:.6g} to {lam[-1]:.6g} (range {lam.min():.6g} ... "
+               f"{lam.max():.6g}), {int(stable.sum())} stable, {int((~stable).sum())} unstable")
+    typer.echo(f"status: {ds.attrs['status']}")
+    n = ds.sizes["special"]
+    if n:
+        sp = ds[f"special_{param}"].values
+        rows = []
+        for i in range(n):
+            re = float(ds.special_multiplier_real[i])
+            im = float(ds.special_multiplier_imag[i])
+            rows.append((SPECIAL_TEXT.get(int(ds.special_type[i]), "?"), f"{sp[i]:.6f}",
+                         _multiplier(re, im), _num(abs(complex(re, im)), ".6g"),
+                         str(int(ds.special_after_point[i]))))
+        print_table(("special point", param, "multiplier", "|mu|", "after point"), rows)
+    else:
+        typer.echo("no special points")
+    echo_written(out, plot)
