@@ -127,3 +127,46 @@ def test_branch_switching_at_period_doubling():
     with pytest.raises(ns.ParameterError, match="^start: special point"):
         continuation(p, "omega", start=(ds, int(np.flatnonzero(ds.special_type.values
                                                                  == GRAZING)[0])))
+
+
+def test_resonance_curve_all_branches():
+    """resonance_curve(branches="all"): the continued branch's omega_a/b/c lie in the sweep's
+    brackets (omega_c: at most a few 1e-5 below, the sweep lingering on the vanishing orbit)
+    and the branch has an unstable part."""
+    ds = ns.resonance_curve(ns.preset("fig6a"), np.linspace(0.5, 1.6, 111), method="exact",
+                            transient=300, record=20, branches="all")
+    a = ds.attrs
+    assert a["omega_a_bracket"][0] - 1e-6 <= a["omega_a_continuation"] <= a["omega_a_bracket"][1]
+    assert a["omega_b_bracket"][0] - 1e-6 <= a["omega_b_continuation"] <= a["omega_b_bracket"][1]
+    assert 0 <= a["omega_c"] - a["omega_c_continuation"] <= 1e-4
+    assert ds.branch_stable.values.min() == 0 and ds.branch_stable.values.max() == 1
+    with pytest.raises(ns.ParameterError, match="^branches"):
+        ns.resonance_curve(ns.preset("fig6a"), [0.9, 1.0], branches="some")
+
+
+def test_two_parameter_grazing_curve_matches_closed_form():
+    """The grazing curve of the contact-free orbit in (omega, F0): F0 = sqrt((omega0^2 -
+    omega^2)^2 + (xi omega)^2) at each located point (the linear amplitude equals the gap)."""
+    from nonsmooth.analysis.continuation import two_parameter_curve
+    p = ns.preset("table3").replace(omega=0.6, F0=0.3)
+    ds = two_parameter_curve(p, "omega", "F0", [0.2, 0.3], special="grazing",
+                             bounds=(0.5, 0.95))
+    w = ds.omega.values[:, 0]
+    F0 = np.sqrt((p.omega0 ** 2 - w ** 2) ** 2 + (p.xi * w) ** 2)
+    assert np.all(np.abs(F0 - ds.F0.values) <= 1e-9)
+    with pytest.raises(ns.ParameterError, match="^special"):
+        two_parameter_curve(p, "omega", "F0", [0.2], special="cusp")
+
+
+def test_cli_two_parameter(tmp_path):
+    from typer.testing import CliRunner
+    from nonsmooth.cli import app
+    out = tmp_path / "two.nc"
+    res = CliRunner().invoke(app, ["continue", "--preset", "table3", "--set", "omega=0.6",
+                                   "--param", "omega", "--bounds", "0.5", "0.95",
+                                   "--two-param", "F0", "--values", "0.2", "0.3", "2",
+                                   "--special", "grazing", "-o", str(out)])
+    assert res.exit_code == 0, res.output
+    import xarray as xr
+    with xr.open_dataset(out) as ds:
+        assert ds.sizes["F0"] == 2 and np.all(np.isfinite(ds.omega.values[:, 0]))

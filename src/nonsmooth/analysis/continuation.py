@@ -466,3 +466,69 @@ def _dataset(params, solver, param, k, pts, specials, status, N, direction, boun
                                bounds_low=float(bounds[0]), bounds_high=float(bounds[1])),
     )
     return ds
+
+
+def two_parameter_curve(params, param: str, param2: str, values2, *, special: str = "fold",
+                        k: int = 1, x0: float = 0.0, v0: float = 0.0, bounds=None,
+                        step: float = 0.01, max_points: int = 400, method: str = "exact",
+                        tol: float = 1e-10) -> xr.Dataset:
+    """A curve of special points in two parameters: for each value of ``param2`` in
+    ``values2``, the branch in ``param`` is continued from the same start (``params``' value
+    of ``param``, Newton from (x0, v0)) over ``bounds`` and every located point of type
+    ``special`` ("fold", "period_doubling", "neimark_sacker" or "grazing") is recorded, so
+    that e.g. the fold pair omega_b, omega_c of Fig. 6 is followed as omega_s changes, or the
+    grazing curve of the contact-free orbit in (omega, F0).
+
+    Returns a Dataset over (``param2``, ``n``): ``<param>`` at the n-th such point of the branch
+    (in ascending order; NaN where fewer were found), the critical multiplier and
+    ``special_jump``; ``status`` per value of ``param2`` (how the branch ended). Each point is
+    located to 1e-10 on its branch; the curve is as fine as ``values2``."""
+    names = {v: kk for kk, v in SPECIAL_NAMES.items()}
+    if special not in names or names[special] == 0:
+        raise ParameterError(f"special: expected one of fold, period_doubling, "
+                             f"neimark_sacker, grazing, got {special!r}")
+    typ = names[special]
+    if not isinstance(param2, str):
+        raise ParameterError(f"param2: expected a parameter name, got {param2!r}")
+    param2 = check_param_name(param2, params)
+    if param2 == param:
+        raise ParameterError(f"param2: must differ from param ({param})")
+    values2 = np.asarray(values2, dtype=float).ravel()
+    if values2.size == 0 or not np.all(np.isfinite(values2)):
+        raise ParameterError(f"values2: expected finite values of {param2}, got {values2!r}")
+    rows, stat = [], []
+    for v in values2:
+        p = params.replace(**{param2: float(v)})
+        br = continuation(p, param, k=k, x0=x0, v0=v0, bounds=bounds, step=step,
+                          max_points=max_points, method=method, tol=tol)
+        sel = br.special_type.values == typ
+        lam = br[f"special_{param}"].values[sel]
+        mu = (br.special_multiplier_real.values + 1j * br.special_multiplier_imag.values)[sel]
+        jump = br.special_jump.values[sel]
+        order = np.argsort(lam)
+        rows.append((lam[order], mu[order], jump[order]))
+        stat.append(br.attrs["status"])
+    n = max([len(r[0]) for r in rows] + [1])
+    L = np.full((len(values2), n), np.nan)
+    MU = np.full((len(values2), n), np.nan + 0j)
+    JP = np.full((len(values2), n), -1, np.int8)
+    for i, (lam, mu, jump) in enumerate(rows):
+        L[i, :len(lam)] = lam
+        MU[i, :len(mu)] = mu
+        JP[i, :len(jump)] = jump
+    s1, s2 = params.model.param(param), params.model.param(param2)
+    return xr.Dataset(
+        {param: ((param2, "n"), L, {"long_name": f"{param} at the {special} points",
+                                    "units": s1.units}),
+         "multiplier_real": ((param2, "n"), MU.real, {"units": "1"}),
+         "multiplier_imag": ((param2, "n"), MU.imag, {"units": "1"}),
+         "special_jump": ((param2, "n"), JP, {"long_name": "1: the multipliers jump there (-1: "
+                                                           "no point)"}),
+         "status": (param2, np.array(stat, dtype=object).astype(str),
+                    {"long_name": "how each branch ended"})},
+        coords={param2: (param2, values2, {"long_name": s2.long_name, "units": s2.units}),
+                "n": np.arange(n)},
+        attrs=provenance_attrs(params, None, swept=(param, param2),
+                               analysis="two_parameter_curve", param=param, param2=param2,
+                               special=special, k=k),
+    )

@@ -166,13 +166,22 @@ def resonance_curve(params: ParamsBase, omegas, *, method: str = "smooth", trans
                     record: int = 50, x0: float = 0.0, v0: float = 0.0, rtol: float = 1e-8,
                     atol: float = 1e-10, transition: str = "eq13", settle: bool = True,
                     resolution: float = 1e-4, branch_tol: float = 1e-3,
-                    workers: int | None = None, progress=None) -> xr.Dataset:
+                    workers: int | None = None, progress=None,
+                    branches: str = "stable") -> xr.Dataset:
     """Resonance curve over the forcing frequencies ``omegas`` (sorted ascending), swept up and
     down with continuation (see :func:`.bifurcation.bifurcation_diagram` for transient, record,
     settle). Returns a Dataset over (sweep, omega) with ``max_X``, ``min_X``, ``period``,
     ``contact``, ``status`` and the section ``X``, ``V``; attrs ``omega_a``, ``omega_b``,
     ``omega_c`` (NaN when absent) refined to ``resolution``, with ``*_bracket`` attrs
-    (definitions in the module docstring)."""
+    (definitions in the module docstring).
+
+    ``branches="all"``: also every branch of period-1 orbits, stable and unstable, by
+    continuation (:func:`.continuation.continuation`) from the up sweep's orbit at the lowest
+    frequency over the whole range: variables ``branch_<omega>``, ``branch_max_X``,
+    ``branch_min_X``, ``branch_stable`` over ``branch_point``, and the attrs
+    ``omega_a_continuation`` (the first grazing), ``omega_c_continuation`` and
+    ``omega_b_continuation`` (the upper and the lower fold), located to 1e-10 instead of by
+    sweeps (a sweep near a fold lingers on the vanishing orbit, so its jump comes late)."""
     from ..simulate import check_float, check_int, check_params
     params = check_params(params)
     transient = check_int("transient", transient, 0)
@@ -190,6 +199,8 @@ def resonance_curve(params: ParamsBase, omegas, *, method: str = "smooth", trans
     branch_tol = check_float("branch_tol", branch_tol)
     if branch_tol <= 0:
         raise ParameterError(f"branch_tol: must be > 0, got {branch_tol}")
+    if branches not in ("stable", "all"):
+        raise ParameterError(f"branches: expected 'stable' or 'all', got {branches!r}")
     solver = Solver(method=method, rtol=rtol, atol=atol, transition=transition,
                     model=params.model)
     out = run_branches(params, w_name, omegas, solver, directions=["up", "down"],
@@ -202,4 +213,34 @@ def resonance_curve(params: ParamsBase, omegas, *, method: str = "smooth", trans
                           analysis="resonance", transient=transient, record=record, x0=x0,
                           v0=v0, settle=settle, resolution=resolution, branch_tol=branch_tol,
                           workers=workers, **freqs)
+    if branches == "all":
+        _all_branches(ds, params, w_name, omegas, out, method)
     return ds
+
+
+def _all_branches(ds, params, w_name, omegas, out, method):
+    """Add the continued period-1 branch (stable and unstable parts) and its special points."""
+    from .continuation import FOLD, GRAZING, continuation
+    up = 0
+    x0, v0 = float(out["X"][up, 0, -1]), float(out["V"][up, 0, -1])
+    br = continuation(params.replace(**{w_name: float(omegas[0])}), w_name, x0=x0, v0=v0,
+                      bounds=(float(omegas[0]), float(omegas[-1])),
+                      step=min(0.01, 0.05 * float(omegas[-1] - omegas[0])),
+                      max_points=2000, method=method)
+    spec = params.model.param(w_name)
+    ds[f"branch_{w_name}"] = ("branch_point", br[w_name].values,
+                              {"long_name": spec.long_name, "units": spec.units})
+    ds["branch_max_X"] = ("branch_point", br.max_X.values,
+                          {"long_name": "largest X on the period-1 orbit (continuation)",
+                           "units": "1"})
+    ds["branch_min_X"] = ("branch_point", br.min_X.values,
+                          {"long_name": "smallest X on the period-1 orbit (continuation)",
+                           "units": "1"})
+    ds["branch_stable"] = ("branch_point", br.stable.values, br.stable.attrs)
+    typ = br.special_type.values
+    lam = br[f"special_{w_name}"].values
+    graz, folds = lam[typ == GRAZING], lam[typ == FOLD]
+    ds.attrs["omega_a_continuation"] = float(graz[0]) if graz.size else math.nan
+    ds.attrs["omega_c_continuation"] = float(folds.max()) if folds.size >= 2 else math.nan
+    ds.attrs["omega_b_continuation"] = float(folds.min()) if folds.size >= 2 else math.nan
+    ds.attrs["branch_status"] = br.attrs["status"]

@@ -181,6 +181,9 @@ def resonance_cmd(
     transition: TransitionOpt = "eq13",
     settle: SettleOpt = True,
     resolution: Annotated[float, typer.Option(help="bisection resolution of omega_a/b/c")] = 1e-4,
+    all_branches: Annotated[bool, typer.Option(
+        "--all", help="also every period-1 branch, stable and unstable, by continuation, with "
+                      "omega_a (grazing), omega_b, omega_c (folds) located on it")] = False,
     workers: WorkersOpt = None,
     out: OutOpt = None,
     plot: PlotOpt = None,
@@ -205,10 +208,15 @@ def resonance_cmd(
         ds = resonance_curve(params, omegas, method=method, transient=transient, record=record,
                              x0=x0, v0=v0, rtol=rtol, atol=atol, transition=transition,
                              settle=settle, resolution=resolution, workers=workers,
-                             progress=prog)
+                             progress=prog, branches="all" if all_branches else "stable")
     from ..plot.resonance import plot_resonance
     save_outputs(ds, preset, out, plot, plot_resonance)
     a = ds.attrs
     typer.echo(f"{preset}: omega_a = {a['omega_a']:.5f} (contact starts), "
                f"omega_b = {a['omega_b']:.5f}, omega_c = {a['omega_c']:.5f} (jumps; NaN = none)")
+    if all_branches:
+        typer.echo(f"continuation ({a['branch_status']}): "
+                   f"omega_a = {a['omega_a_continuation']:.8f} (grazing), "
+                   f"omega_b = {a['omega_b_continuation']:.8f}, "
+                   f"omega_c = {a['omega_c_continuation']:.8f} (folds; NaN = none)")
     echo_written(out, plot)

@@ -69,6 +69,16 @@ def continue_cmd(
     method: OrbitMethodOpt = None,
     rtol: RtolOpt = 1e-10,
     atol: AtolOpt = 1e-12,
+    two_param: Annotated[Optional[str], typer.Option(
+        "--two-param", show_default=False,
+        help="a second parameter: follow the --special points of the branch as it changes "
+             "over --values (a two-parameter curve)")] = None,
+    values: Annotated[Optional[tuple[float, float, int]], typer.Option(
+        "--values", show_default=False,
+        help="FROM TO N: the values of --two-param")] = None,
+    special: Annotated[str, typer.Option(
+        "--special", help="fold, period_doubling, neimark_sacker or grazing (--two-param)")]
+    = "fold",
     out: OutOpt = None,
     plot: PlotOpt = None,
 ):
@@ -101,6 +111,9 @@ def continue_cmd(
     if bounds is not None and not bounds[0] <= lam0 <= bounds[1]:
         raise ParameterError(f"bounds: {bounds[0]:g} ... {bounds[1]:g} exclude the start "
                              f"{param} = {lam0:g} (set it with --set {param}=VALUE)")
+    if two_param is not None:
+        return _two_parameter(params, preset, param, two_param, values, special, k, x0, v0,
+                              step, bounds, max_points, method, tol, out, plot)
     check_outputs(out, plot)
     ds = continuation(params, param, k=k, x0=x0, v0=v0, transient=transient,
                       direction=direction, step=step, max_step=max_step, bounds=bounds,
@@ -126,4 +139,32 @@ def continue_cmd(
         print_table(("special point", param, "multiplier", "|mu|", "after point"), rows)
     else:
         typer.echo("no special points")
+    echo_written(out, plot)
+
+
+def _two_parameter(params, preset, param, param2, values, special, k, x0, v0, step, bounds,
+                   max_points, method, tol, out, plot):
+    """``nonsmooth continue --two-param``: the curve of --special points in (param, param2)."""
+    import numpy as np
+
+    from ..analysis.continuation import two_parameter_curve
+    from ..params import check_param_name
+    from ..plot.continuation import plot_two_parameter
+    from .analyses import value_range
+
+    check_param_name(param2, params)
+    if values is None:
+        raise ParameterError("values: --two-param needs --values FROM TO N")
+    grid = value_range(values[0], values[1], values[2], f"{param2} values")
+    check_outputs(out, plot)
+    ds = two_parameter_curve(params, param, param2, grid, special=special, k=k, x0=x0, v0=v0,
+                             bounds=bounds, step=step, max_points=max_points, method=method,
+                             tol=tol)
+    save_outputs(ds, preset, out, plot, plot_two_parameter)
+    found = int(np.isfinite(ds[param].values).any(axis=1).sum())
+    typer.echo(f"{preset} ({method}): {special} points in ({param}, {param2}) at {found} of "
+               f"{grid.size} values of {param2}")
+    print_table((param2, *[f"{param} #{j}" for j in range(ds.sizes['n'])]),
+                [(f"{v:.6g}", *[("-" if not np.isfinite(x) else f"{x:.8f}") for x in row])
+                 for v, row in zip(ds[param2].values, ds[param].values)])
     echo_written(out, plot)

@@ -219,3 +219,24 @@ def plot_continuation(ds, var: str = "max_X", ax=None):
     if own:
         fig.tight_layout()
     return fig
+
+
+def plot_two_parameter(ds, ax=None):
+    """A two-parameter curve (``analysis.continuation.two_parameter_curve``): the special
+    points' first parameter versus the second, one line per point of the branch."""
+    param, param2 = ds.attrs["param"], ds.attrs["param2"]
+    if ax is None:
+        fig, ax = new_figure(figsize=(7, 5))
+    else:
+        fig = ax.figure
+    m = model_of(ds)
+    y = ds[param2].values
+    for j in range(ds.sizes["n"]):
+        ax.plot(ds[param].values[:, j], y, marker=".", lw=1.2, label=f"{ds.attrs['special']} #{j}")
+    ax.set_xlabel(f"{param_symbol(m, param)} [{ds[param].attrs.get('units', '')}]")
+    ax.set_ylabel(f"{param_symbol(m, param2)} [{ds[param2].attrs.get('units', '')}]")
+    ax.set_title(f"{ds.attrs['special']} points in ({param}, {param2})", fontsize=10)
+    ax.grid(True, lw=0.3, alpha=0.5)
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    return fig

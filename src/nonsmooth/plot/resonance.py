@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
 
 from .bifurcation import SWEEP_STYLE, draw_lines_over, sweep_names
 from .common import model_of, new_figure, param_symbol, param_title
@@ -24,6 +25,17 @@ def plot_resonance(ds, show_min: bool = True):
         if show_min:
             style.pop("label")
             ax.plot(w, ds.min_X.values[j], ls=ls, lw=0.8, markersize=2, alpha=0.6, **style)
+    if f"branch_{wname}" in ds:  # every period-1 branch (continuation): unstable dashed
+        bw, bm, stb = (ds[f"branch_{wname}"].values, ds.branch_max_X.values,
+                       ds.branch_stable.values)
+        for flag, ls, lab in ((1, "-", "period-1 branch, stable"),
+                              (0, "--", "period-1 branch, unstable")):
+            y = bm.astype(float).copy()
+            y[stb != flag] = math.nan
+            if flag == 0:  # join the dashed part to its stable neighbours
+                edge = (stb == 0) | np.r_[stb[1:] == 0, False] | np.r_[False, stb[:-1] == 0]
+                y = np.where(edge, bm, math.nan)
+            ax.plot(bw, y, ls=ls, color="k", lw=1.3, label=lab, zorder=3)
     draw_lines_over(ax, ds, wname, w, style=dict(ls=":"))
     for key, sym, col in (("omega_a", r"\omega_a", "#2ca02c"), ("omega_b", r"\omega_b", "#9467bd"),
                           ("omega_c", r"\omega_c", "#8c564b")):
