@@ -130,15 +130,15 @@ def test_branch_switching_at_period_doubling():
 
 
 def test_resonance_curve_all_branches():
-    """resonance_curve(branches="all"): the continued branch's omega_a/b/c lie in the sweep's
-    brackets (omega_c: at most a few 1e-5 below, the sweep lingering on the vanishing orbit)
-    and the branch has an unstable part."""
+    """resonance_curve(branches="all"): omega_a/b/c located on the continued branch agree with
+    the sweep-based ones (bisection refined to 2e-6) to 1e-5 (measured: 4e-7, 3e-7, 2.3e-6;
+    the sweep's omega_c comes late by the slow passage near the fold, 1.6e-7 with a transient
+    of 3000), and the branch has an unstable part."""
     ds = ns.resonance_curve(ns.preset("fig6a"), np.linspace(0.5, 1.6, 111), method="exact",
-                            transient=300, record=20, branches="all")
+                            transient=500, record=20, resolution=2e-6, branches="all")
     a = ds.attrs
-    assert a["omega_a_bracket"][0] - 1e-6 <= a["omega_a_continuation"] <= a["omega_a_bracket"][1]
-    assert a["omega_b_bracket"][0] - 1e-6 <= a["omega_b_continuation"] <= a["omega_b_bracket"][1]
-    assert 0 <= a["omega_c"] - a["omega_c_continuation"] <= 1e-4
+    for key in ("omega_a", "omega_b", "omega_c"):
+        assert abs(a[key] - a[f"{key}_continuation"]) <= 1e-5, key
     assert ds.branch_stable.values.min() == 0 and ds.branch_stable.values.max() == 1
     with pytest.raises(ns.ParameterError, match="^branches"):
         ns.resonance_curve(ns.preset("fig6a"), [0.9, 1.0], branches="some")
@@ -170,3 +170,18 @@ def test_cli_two_parameter(tmp_path):
     import xarray as xr
     with xr.open_dataset(out) as ds:
         assert ds.sizes["F0"] == 2 and np.all(np.isfinite(ds.omega.values[:, 0]))
+
+
+def test_stable_parts_agree_with_a_sweep(fig6a_branch):
+    """Stable points of the branch (below omega_a, on the contact branch, above omega_c) are the
+    attractors a sweep settles on: max X from bifurcation_diagram at the same omega."""
+    br = fig6a_branch
+    idx = [3, 25, len(br.omega) - 4]
+    assert all(int(br.stable[i]) == 1 for i in idx)
+    for i in idx:
+        om = float(br.omega[i])
+        sw = ns.bifurcation_diagram(ns.preset("fig6a"), "omega", [om, om + 1e-9], sweep="fresh",
+                                    method="exact", transient=2000, record=5,
+                                    x0=float(br.X_section[i, 0]) + 1e-3,
+                                    v0=float(br.V_section[i, 0]), lyapunov=False)
+        assert float(sw.max_X[0, 0]) == pytest.approx(float(br.max_X[i]), abs=1e-6)
