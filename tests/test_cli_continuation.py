@@ -9,23 +9,11 @@ import xarray as xr
 
 import nonsmooth as ns
 import nonsmooth.plot as nsplot
-from nonsmooth.cli import main
 from nonsmooth.io import load_dataset
+from cli_helpers import one_line, run_cli  # noqa: E402
 
 PNG = b"\x89PNG"
 FIG6A = ["--preset", "fig6a", "--set", "omega=0.5", "--param", "omega", "--bounds", "0.5", "1.6"]
-
-
-def run_cli(argv, capsys):
-    with pytest.raises(SystemExit) as exc:
-        main(argv)
-    cap = capsys.readouterr()
-    return exc.value.code or 0, cap.out, cap.err
-
-
-def one_line(err: str, needle: str) -> None:
-    lines = [ln for ln in err.splitlines() if ln.strip()]
-    assert len(lines) == 1 and lines[0].startswith("error: ") and needle in lines[0], lines
 
 
 @pytest.fixture(scope="module")

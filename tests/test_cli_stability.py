@@ -13,25 +13,13 @@ import xarray as xr
 
 import nonsmooth as ns
 import nonsmooth.plot as nsplot
-from nonsmooth.cli import main
 from nonsmooth.io import load_dataset
+from cli_helpers import one_line, run_cli  # noqa: E402
 
 PNG = b"\x89PNG"
 CHAOS = ["--preset", "table3", "--set", "omega=0.92", "--periods", "200", "--transient", "50"]
 SADDLE = ["--preset", "fig7", "--x0", "-1.5", "--v0", "0.25"]  # Fig. 7's unstable orbit
 NO_ORBIT = ["--x0", "50", "--v0", "50"]  # Newton diverges from there
-
-
-def run_cli(argv, capsys):
-    with pytest.raises(SystemExit) as exc:
-        main(argv)
-    cap = capsys.readouterr()
-    return exc.value.code or 0, cap.out, cap.err
-
-
-def one_line(err: str, needle: str) -> None:
-    lines = [ln for ln in err.splitlines() if ln.strip()]
-    assert len(lines) == 1 and lines[0].startswith("error: ") and needle in lines[0], lines
 
 
 @pytest.fixture(scope="module")
