@@ -32,6 +32,7 @@ _LAZY = {
     "lyapunov": ".analysis.stability",
     "periodic_orbit": ".analysis.stability",
     "continuation": ".analysis.continuation",
+    "two_parameter_curve": ".analysis.continuation",
     "reproduce": ".reproduction",
 }
 
@@ -40,7 +41,7 @@ _SUBMODULES = ("analysis", "cli", "errors", "integrate", "io", "kernels", "model
                "plot", "presets", "reproduction", "status", "sweep")
 
 __all__ = ["__version__", "Params", "PARAM_NAMES", "model", "models", "preset", "PRESETS", "simulate", "reproduce", "Solver",
-           "eta_study", "lyapunov", "periodic_orbit", "continuation", "poincare", "bifurcation_diagram", "resonance_curve", "basins",
+           "eta_study", "lyapunov", "periodic_orbit", "continuation", "two_parameter_curve", "poincare", "bifurcation_diagram", "resonance_curve", "basins",
            "NonsmoothError", "ParameterError", "OutputError", "IntegrationError"]
 
 
