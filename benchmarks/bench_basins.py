@@ -21,16 +21,22 @@ import numba
 from nonsmooth import preset
 from nonsmooth.analysis.basins import basins
 
+def lyapunov_option(fn, wanted: bool) -> dict:
+    """``lyapunov=wanted`` where ``fn`` has that option (older commits do not)."""
+    import inspect
+    return {"lyapunov": wanted} if "lyapunov" in inspect.signature(fn).parameters else {}
+
+
 
 def load():
     a, b, _ = os.getloadavg()
     return f"load(1m,5m)={a:.2f},{b:.2f}"
 
 
-def run(params, method, grid, workers):
+def run(params, method, grid, workers, kw):
     l0 = load()
     t0 = time.perf_counter()
-    ds = basins(params, grid=grid, method=method, workers=workers)
+    ds = basins(params, grid=grid, method=method, workers=workers, **kw)
     dt = time.perf_counter() - t0
     work = ds.attrs["total_periods"] + ds.attrs["certification_periods"]
     fr = ", ".join(f"A{k}(p{int(ds.period[k])},c{int(ds.contact[k])})={float(ds.fraction[k]):.4f}"
@@ -47,7 +53,10 @@ def main():
     ap.add_argument("--omega", type=float, default=1.10)
     ap.add_argument("--grids", type=int, nargs="+", default=[200, 1000])
     ap.add_argument("--workers", type=int, default=None)
+    ap.add_argument("--lyapunov", action="store_true",
+                    help="also lambda1 per attractor (off: comparable with commits before it)")
     a = ap.parse_args()
+    kw = lyapunov_option(basins, a.lyapunov)
     params = preset("fig7").replace(omega=a.omega)
     methods = ("exact", "smooth") if a.method == "both" else (a.method,)
     targets = {"exact": 20.0, "smooth": 120.0}
@@ -55,10 +64,10 @@ def main():
           f"threads={a.workers or numba.config.NUMBA_NUM_THREADS}, {load()}")
     total = 0.0
     for m in methods:
-        basins(params, grid=4, method=m, workers=a.workers)  # compilation / cache load
+        basins(params, grid=4, method=m, workers=a.workers, **kw)  # compilation / cache load
         times = {}
         for g in a.grids:
-            times[g] = run(params, m, g, a.workers)
+            times[g] = run(params, m, g, a.workers, kw)
             total += times[g]
         g0 = min(times)
         est = times[g0] * (1000 / g0) ** 2

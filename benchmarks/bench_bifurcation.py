@@ -16,6 +16,12 @@ import numpy as np
 from nonsmooth import preset
 from nonsmooth.analysis.bifurcation import bifurcation_diagram
 
+def lyapunov_option(fn, wanted: bool) -> dict:
+    """``lyapunov=wanted`` where ``fn`` has that option (older commits do not)."""
+    import inspect
+    return {"lyapunov": wanted} if "lyapunov" in inspect.signature(fn).parameters else {}
+
+
 
 def main():
     ap = argparse.ArgumentParser()
@@ -26,6 +32,9 @@ def main():
     ap.add_argument("--sweep", default="both")
     ap.add_argument("--method", default="smooth")
     ap.add_argument("--no-settle", action="store_true")
+    ap.add_argument("--lyapunov", action="store_true",
+                    help="also lambda1 per point (off: the sweep alone, comparable with "
+                         "commits before lambda1 existed)")
     ap.add_argument("--no-extend", action="store_true",
                     help="no extension of still-converging sections (isolates the sweep itself)")
     a = ap.parse_args()
@@ -35,14 +44,15 @@ def main():
     params = preset("table3")
     values = np.linspace(0.8, 1.0, a.values)
     # warm-up (compilation / cache load)
+    kw = lyapunov_option(bifurcation_diagram, a.lyapunov)
     bifurcation_diagram(params, "omega", values[:2], sweep=a.sweep, transient=2, record=2,
-                        method=a.method, workers=a.workers)
+                        method=a.method, workers=a.workers, **kw)
     load0 = os.getloadavg()
     c0 = time.process_time()
     t0 = time.perf_counter()
     ds = bifurcation_diagram(params, "omega", values, sweep=a.sweep, transient=a.transient,
                              record=a.record, method=a.method, workers=a.workers,
-                             settle=not a.no_settle)
+                             settle=not a.no_settle, **kw)
     dt = time.perf_counter() - t0
     cpu = time.process_time() - c0
     load1 = os.getloadavg()
@@ -51,7 +61,7 @@ def main():
     actual = int(ds.transient_used.sum()) + a.values * nsw * a.record
     print(f"bifurcation table3 omega [0.8, 1.0], {a.values} values x ({a.transient} + {a.record}) "
           f"periods, sweep={a.sweep}, method={a.method}, settle={not a.no_settle}, "
-          f"workers={a.workers or 'all'}")
+          f"workers={a.workers or 'all'}, lambda1={bool(kw.get('lyapunov', False))}")
     print(f"time {dt:.2f} s; nominal {nominal / dt:,.0f} trajectory-periods/s; "
           f"integrated {actual:,} periods ({actual / nominal:.0%} of nominal), {actual / dt:,.0f} periods/s")
     print(f"CPU time {cpu:.2f} s (all threads): {actual / cpu:,.0f} periods per CPU-second; "

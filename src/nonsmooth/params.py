@@ -148,23 +148,10 @@ class Params(ParamsBase):
         ``param_<name>`` attributes. A parameter swept in the Dataset (a coordinate or variable
         of that name) must be given in ``point`` (``Params.from_attrs(ds, omega=0.92)``): its
         value is a point of the sweep, never an attribute. One-line ParameterError otherwise."""
-        variables = getattr(source, "variables", {})
-        attrs = getattr(source, "attrs", source)
         if unknown := sorted(set(point) - set(PARAM_NAMES)):
             raise ParameterError(f"{unknown[0]}: unknown parameter (known: {', '.join(PARAM_NAMES)})")
-        values = {}
-        for n in PARAM_NAMES:
-            if n in point:
-                values[n] = point[n]
-            elif n in variables:
-                raise ParameterError(f"{n}: swept in this dataset; give the point, e.g. "
-                                     f"Params.from_attrs(ds, {n}=...)")
-            elif f"param_{n}" in attrs:
-                values[n] = float(attrs[f"param_{n}"])
-            else:
-                raise ParameterError(f"{n}: no param_{n} attribute (a swept parameter?); give "
-                                     f"its value, e.g. Params.from_attrs(attrs, {n}=...)")
-        return cls(**values)
+        from .models.support import MODEL
+        return MODEL.params_from_attrs(source, _call="Params.from_attrs", **point)
 
 
 def check_param_name(name: str, params=None) -> str:

@@ -31,6 +31,7 @@ import xarray as xr
 
 from .. import status as st
 from ..errors import ParameterError
+from ..integrate.roots import illinois_point, illinois_update
 from ..io import provenance_attrs
 from ..kernels import output_buffers, run
 from ..models.base import KERNEL_GENERIC
@@ -93,10 +94,8 @@ class _Branch:
             ev = self.evaluate(y[:N], y[N])
             if ev is None:
                 return None
-            F, M, Fl, s0, _ = ev
-            act = _active(M, self.setup.n)
-            ia = np.flatnonzero(act)
-            J = np.hstack([(M - np.eye(N))[np.ix_(ia, ia)], Fl[ia, None]])
+            F = ev[0]
+            act, ia, J = self.jacobian(ev)
             tt = np.concatenate([t[ia], t[N:]])
             A = np.vstack([J, tt[None, :]])
             rhs = -np.concatenate([F[ia], [tt @ (np.concatenate([y[ia], y[N:]])
@@ -120,13 +119,18 @@ class _Branch:
                 return y, ev, it
         return None
 
-    def tangent(self, ev, t_prev):
-        """Unit tangent at a corrected point, oriented along t_prev."""
+    def jacobian(self, ev):
+        """(active mask, active indices, [M - I, dF/dlam] on the active coordinates) of an
+        evaluation (memory rewritten before it is read is not a coordinate, see ``_active``)."""
         F, M, Fl, s0, _ = ev
-        N = self.setup.N
         act = _active(M, self.setup.n)
         ia = np.flatnonzero(act)
-        J = np.hstack([(M - np.eye(N))[np.ix_(ia, ia)], Fl[ia, None]])
+        return act, ia, np.hstack([(M - np.eye(len(M)))[np.ix_(ia, ia)], Fl[ia, None]])
+
+    def tangent(self, ev, t_prev):
+        """Unit tangent at a corrected point, oriented along t_prev."""
+        N = self.setup.N
+        act, ia, J = self.jacobian(ev)
         tp = np.concatenate([t_prev[ia], t_prev[N:]])
         try:
             v = np.linalg.solve(np.vstack([J, tp[None, :]]), np.r_[np.zeros(len(ia)), 1.0])
@@ -348,37 +352,24 @@ def _start_state(setup, p, orb, state):
 def _locate(br, typ, y0, t0, ds, a, b):
     """Illinois on the arclength s in (0, ds) from y0 along t0 for a zero of test ``typ``;
     returns (lam, multiplier nearest the crossing, y) or None."""
-    sa, sb = 0.0, ds
-    fa, fb = a, b
+    # Illinois in the normalised test g = f sign(f(ds)): g(0) > 0 (lo side), g(ds) < 0 (hi)
+    sg = -1.0 if b > 0 else 1.0
+    lo, hi, glo, ghi = 0.0, ds, sg * a, sg * b
     side = 0
     best = None
     mu_sides = [None, None]  # multipliers at the last point found on each side
     for _ in range(60):
-        s = (sa * fb - sb * fa) / (fb - fa) if fb != fa else 0.5 * (sa + sb)
-        if not sa < s < sb:
-            s = 0.5 * (sa + sb)
+        s = illinois_point(lo, hi, glo, ghi)
         got = br.correct(y0 + s * t0, t0)
         if got is None:
             return None
         y, ev, _ = got
-        t = br.tangent(ev, t0)
-        f = br.features(y, ev, t)
-        fs = f["tests"][typ]
+        f = br.features(y, ev, br.tangent(ev, t0))
+        gs = sg * f["tests"][typ]
         best = (y, f)
-        mu_sides[0 if fs * fa > 0 else 1] = f["mu"]
-        if fs * fa > 0:
-            sa, fa = s, fs
-            if side == -1:
-                fb *= 0.5
-            side = -1
-        else:
-            sb, fb = s, fs
-            if side == 1:
-                fa *= 0.5
-            side = 1
-        lam_a = y0[-1] + sa * t0[-1]
-        lam_b = y0[-1] + sb * t0[-1]
-        if abs(lam_b - lam_a) <= LOCATE_TOL * max(1.0, abs(y[-1])) or fs == 0.0:
+        mu_sides[1 if gs < 0.0 else 0] = f["mu"]
+        lo, hi, glo, ghi, side = illinois_update(lo, hi, glo, ghi, side, s, gs)
+        if (abs(t0[-1]) * (hi - lo) <= LOCATE_TOL * max(1.0, abs(y[-1]))) or gs == 0.0:
             break
     y, f = best
     mu = f["mu"]

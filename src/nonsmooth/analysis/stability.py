@@ -271,7 +271,8 @@ def periodic_orbit(params, *, k: int = 1, x0: float = 0.0, v0: float = 0.0,
         for _ in range(13):  # damped step: accept the first that reduces |F|
             zt = z + lam * dz
             st_t = _section_state(setup, p, zt, s0)
-            s1t, _, code_t, _ = _map_only(setup, p, st_t, k)
+            s1t = st_t.copy()  # the k-fold map without the tangent (a line-search trial)
+            code_t = run(KERNEL_GENERIC, setup.fns, p, opts, s1t, 1, k, 0, *output_buffers(0))
             if code_t == st.OK:
                 rt = float(np.linalg.norm(setup.z_of(s1t) - zt))
                 if rt < res:
@@ -372,13 +373,6 @@ def _active(M, n):
     return act
 
 
-def _map_only(setup, p, state, k):
-    """The k-fold map without the tangent (for line-search trials)."""
-    s = state.copy()
-    code = run(KERNEL_GENERIC, setup.fns, p, setup.opts, s, 1, k, 0, *output_buffers(0))
-    return s, None, code, None
-
-
 # ---- lambda1 of many points (sweeps) ----------------------------------------------------------
 @nb.njit(cache=True, parallel=True)
 def _lambda1_many(fns, P, opts, states, align, periods, N, cmi, logs, status):
@@ -424,7 +418,7 @@ def lambda1_points(P, solver, states, periods: int, *, blocks: int = 10, workers
     T = 2.0 * np.pi / om
     with np.errstate(invalid="ignore"):
         lam = logs.mean(axis=1) / T
-        err = np.array([block_error(logs[i][:, None], blocks)[0] for i in range(len(P))]) / T
+        err = block_error(logs.T, blocks) / T  # one column per point
     bad = status != st.OK
     lam[bad] = np.nan
     err[bad] = np.nan
@@ -432,15 +426,16 @@ def lambda1_points(P, solver, states, periods: int, *, blocks: int = 10, workers
 
 
 def classify_points(lam, err, period) -> np.ndarray:
-    """:func:`classify` over arrays (0 where lambda1 is NaN and no period was found)."""
-    out = np.zeros(np.shape(period), np.int8)
-    for idx in np.ndindex(out.shape):
-        pr = int(np.asarray(period)[idx])
-        if pr == -1:
-            out[idx] = NOT_SETTLED
-        else:
-            out[idx] = classify(float(np.asarray(lam)[idx]), float(np.asarray(err)[idx]), pr)
-    return out
+    """:func:`classify` over arrays (period -1: not settled)."""
+    lam = np.asarray(lam, dtype=float)
+    err = np.asarray(err, dtype=float)
+    period = np.asarray(period)
+    finite = np.isfinite(lam) & np.isfinite(err)
+    return np.select(
+        [period > 0, period == -1, ~finite & (lam == -np.inf), ~finite, lam > N_SIGMA * err,
+         np.abs(lam) <= N_SIGMA * err],
+        [PERIODIC, NOT_SETTLED, NOT_SETTLED, 0, CHAOTIC, QUASI_PERIODIC],
+        NOT_SETTLED).astype(np.int8)
 
 
 def motion_attrs() -> dict:

@@ -62,10 +62,10 @@ from .contract import (  # noqa: E402
     ST_VA,
     ST_X,
 )
-from .pwlinear import (MC_A, MC_K, MC_LMAX, N_MC, accel, eval_state, hom_part,  # noqa: E402
-                       mode_coeffs, propagator)
+from .pwlinear import (MC_A, MC_K, MC_LMAX, N_MC, accel, eval_state, herm_coeffs,  # noqa: E402
+                       hom_part, mode_coeffs, propagator)
 from .record import record_interval  # noqa: E402
-from .roots import quad_roots01  # noqa: E402
+from .roots import illinois_point, illinois_update, quad_roots01  # noqa: E402
 from .rkstep import (_A, _B, _C, _E, _FM, _NS, _control, _cubic, _shrink,  # noqa: E402
                      _x_extrema)
 from .trig import cos_sin_small  # noqa: E402
@@ -165,10 +165,7 @@ def _rk_step(field, mode, tau, C, S, h, om, n, u, k0, pp, mem, rtol, atol, us, k
 def _x_extrema_exact(MC, m, om, y0, z0, C, S, X, V, X1, V1, h, xmax, xmin):
     """Interior extrema of X on a closed-form piece of length h: first guesses from the cubic
     Hermite of X, then Newton on V(s) = 0 with the exact state (V' = X'')."""
-    dX = X1 - X
-    a1 = h * V
-    a2 = 3.0 * dX - 2.0 * h * V - h * V1
-    a3 = -2.0 * dX + h * V + h * V1
+    a1, a2, a3 = herm_coeffs(X, V, X1, V1, h)
     q1, q2 = quad_roots01(a1, 2.0 * a2, 3.0 * a3)
     for q in (q1, q2):
         if q > 0.0:
@@ -615,10 +612,7 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
                     if g1 < 0.0:
                         hi = 1.0
                         ghi = g1
-                    dg = g1 - g0
-                    b1 = hs * d0
-                    b2 = 3.0 * dg - 2.0 * hs * d0 - hs * d1
-                    b3 = -2.0 * dg + hs * d0 + hs * d1
+                    b1, b2, b3 = herm_coeffs(g0, d0, g1, d1, hs)
                     r1, r2 = quad_roots01(b1, 2.0 * b2, 3.0 * b3)
                     for q in (r1, r2):
                         if 0.0 < q < hi and 2.0 * b2 + 6.0 * b3 * q > 0.0:  # a minimum
@@ -642,24 +636,10 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
                     for _ in range(200):
                         if hi - lo <= S_TOL:
                             break
-                        den = ghi - glo
-                        sm = (lo * ghi - hi * glo) / den if den != 0.0 else 0.5 * (lo + hi)
-                        if not (lo < sm < hi):
-                            sm = 0.5 * (lo + hi)
+                        sm = illinois_point(lo, hi, glo, ghi)
                         gm = _g_at(cf, sm, G, k, n, q0, q1, q2, q3, C, S, om, hs, MC, mode,
                                    y0, z0)
-                        if gm < 0.0:
-                            hi = sm
-                            ghi = gm
-                            if side == -1:
-                                glo *= 0.5
-                            side = -1
-                        else:
-                            lo = sm
-                            glo = gm
-                            if side == 1:
-                                ghi *= 0.5
-                            side = 1
+                        lo, hi, glo, ghi, side = illinois_update(lo, hi, glo, ghi, side, sm, gm)
                     if hi - lo > S_TOL:
                         code = st.EVENT_FAILED
                         break

@@ -255,7 +255,7 @@ def cubic_max(c0, c1, c2, c3, L):
 
 
 @nb.njit(cache=True, inline="always")
-def _herm_coeffs(g0, d0, g1, d1, L):
+def herm_coeffs(g0, d0, g1, d1, L):
     """Cubic Hermite in u = s / L: H = g0 + a1 u + a2 u^2 + a3 u^3."""
     dg = g1 - g0
     a1 = L * d0
@@ -267,7 +267,7 @@ def _herm_coeffs(g0, d0, g1, d1, L):
 @nb.njit(cache=True, inline="always")
 def herm_max(g0, d0, g1, d1, L):
     """Max over [0, L] of the cubic Hermite interpolant of (g, g') and its argmax s."""
-    a1, a2, a3 = _herm_coeffs(g0, d0, g1, d1, L)
+    a1, a2, a3 = herm_coeffs(g0, d0, g1, d1, L)
     best = g0
     arg = 0.0
     if g1 > best:
@@ -287,7 +287,7 @@ def herm_max(g0, d0, g1, d1, L):
 @nb.njit(cache=True, inline="always")
 def herm_min_deriv(g0, d0, g1, d1, L):
     """Min over [0, L] of the derivative of the cubic Hermite interpolant."""
-    a1, a2, a3 = _herm_coeffs(g0, d0, g1, d1, L)
+    a1, a2, a3 = herm_coeffs(g0, d0, g1, d1, L)
     m = min(d0, d1)
     if a3 > 0.0:  # H' is a convex quadratic in u: interior minimum at u = -a2 / (3 a3)
         u = -a2 / (3.0 * a3)
@@ -343,7 +343,7 @@ def classify(g0, d0, dd0, g1, d1, L, M2, M3, M4):
 def herm_root(g0, d0, g1, d1, L):
     """Root in (0, L) of the cubic Hermite interpolant (g0 < 0 <= g1): a few Newton steps on
     the cubic from the secant point, kept inside the interval (a cheap first guess)."""
-    a1, a2, a3 = _herm_coeffs(g0, d0, g1, d1, L)
+    a1, a2, a3 = herm_coeffs(g0, d0, g1, d1, L)
     u = -g0 / (g1 - g0)
     for _ in range(4):
         h = g0 + u * (a1 + u * (a2 + u * a3))

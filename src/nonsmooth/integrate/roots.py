@@ -1,4 +1,5 @@
-"""Roots of low-degree polynomials, shared by the kernels (extrema of Hermite cubics)."""
+"""Roots shared by the kernels: low-degree polynomials (extrema of Hermite cubics) and the
+Illinois (modified regula falsi) bracketing steps of event location."""
 
 import math
 
@@ -29,3 +30,34 @@ def quad_roots01(c0, c1, c2):
         if 0.0 < s < 1.0:
             r2 = s
     return r1, r2
+
+
+@nb.njit(cache=True, inline="always")
+def illinois_point(lo, hi, glo, ghi):
+    """Next trial in the bracket [lo, hi] (values glo, ghi of opposite signs): the secant
+    point, or the midpoint when that falls outside the bracket."""
+    den = ghi - glo
+    sm = (lo * ghi - hi * glo) / den if den != 0.0 else 0.5 * (lo + hi)
+    if not (lo < sm < hi):
+        sm = 0.5 * (lo + hi)
+    return sm
+
+
+@nb.njit(cache=True, inline="always")
+def illinois_update(lo, hi, glo, ghi, side, sm, gm):
+    """The bracket after the trial (sm, gm): g < 0 on the ``hi`` side, g >= 0 on the ``lo``
+    side. The value kept at an end that stays twice in a row is halved (Illinois), so the
+    bracket shrinks from both sides. Returns (lo, hi, glo, ghi, side)."""
+    if gm < 0.0:
+        hi = sm
+        ghi = gm
+        if side == -1:
+            glo *= 0.5
+        side = -1
+    else:
+        lo = sm
+        glo = gm
+        if side == 1:
+            ghi *= 0.5
+        side = 1
+    return lo, hi, glo, ghi, side

@@ -334,8 +334,9 @@ class Model:
                                  f"(known: {', '.join(self.presets) or 'none'})") from None
         return self.params(**values)
 
-    def params_from_attrs(self, source, **point):
-        """The parameters of a result (``param_<name>`` attrs; swept ones given in ``point``)."""
+    def params_from_attrs(self, source, _call: str = "from_attrs", **point):
+        """The parameters of a result (``param_<name>`` attrs; swept ones given in ``point``);
+        ``_call`` is how the messages name the call."""
         variables = getattr(source, "variables", {})
         attrs = getattr(source, "attrs", source)
         for k in point:
@@ -347,12 +348,12 @@ class Model:
                 values[n] = point[n]
             elif n in variables:
                 raise ParameterError(f"{n}: swept in this dataset; give the point, e.g. "
-                                     f"from_attrs(ds, {n}=...)")
+                                     f"{_call}(ds, {n}=...)")
             elif f"param_{n}" in attrs:
                 values[n] = float(attrs[f"param_{n}"])
             else:
                 raise ParameterError(f"{n}: no param_{n} attribute (a swept parameter?); give "
-                                     f"its value, e.g. from_attrs(attrs, {n}=...)")
+                                     f"its value, e.g. {_call}(attrs, {n}=...)")
         return self.params(**values)
 
     # ---- methods ----

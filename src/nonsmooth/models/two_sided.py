@@ -33,6 +33,8 @@ import numba as nb
 from ..errors import ParameterError
 from .base import Method, Model, Param, _PARAM_NAMES, param_index
 from .oscillator import row as _row
+from .support.switch import (GAMMA_MINUS, GAMMA_PLUS, SIGMA_ALPHA, SIGMA_BETA,
+                             crossed_normal, region_gap)
 
 PARAMETERS = (
     Param("omega0", 1.0, low=0.0, low_open=True, units="rad/s",
@@ -69,7 +71,7 @@ FREE = 0
 CONTACT_R = 3
 CONTACT_L = 6
 # local region codes of one side (as the support model's eq. 14)
-_GM, _SA, _SB, _GP = 0, 1, 2, 3
+_GM, _SA, _SB, _GP = GAMMA_MINUS, SIGMA_ALPHA, SIGMA_BETA, GAMMA_PLUS
 N_MEMORY = 4
 # memory slots
 _VA_R, _SEL_R, _VA_L, _SEL_L = 0, 1, 2, 3
@@ -93,20 +95,6 @@ def _side(p, side):
 
 
 @nb.njit(cache=True, inline="always")
-def _region(Y, W, g, eta, r):
-    """Local region (eq. 14 with 1 -> g) of the side coordinates (Y, W)."""
-    ha = Y - g
-    hb = -ha - r * W
-    if ha <= -eta or hb >= eta:
-        return _GM
-    if ha >= eta and hb <= -eta:
-        return _GP
-    if ha < eta and hb <= -ha:
-        return _SA
-    return _SB
-
-
-@nb.njit(cache=True, inline="always")
 def _split(mode):
     """(side, local region) of a smooth mode; the free mode is (-1, Gamma-)."""
     if mode == FREE:
@@ -120,11 +108,11 @@ def _split(mode):
 def _classify(X, V, p):
     eta = p[_ETA]
     s, g, w2, x, r = _side(p, 0)
-    lr = _region(X, V, g, eta, r)
+    lr = region_gap(X, V, g, eta, r)
     if lr != _GM:
         return lr
     s, g, w2, x, r = _side(p, 1)
-    lr = _region(-X, -V, g, eta, r)
+    lr = region_gap(-X, -V, g, eta, r)
     if lr != _GM:
         return 3 + lr
     return FREE
@@ -243,37 +231,12 @@ def smooth_transition(mode, k, t, c, s, u, p, mem):
             mem[sel_slot] = 0.0
             return FREE
     # outward normal of the crossed surface in side coordinates
-    a = 0.0
-    b = 0.0
-    if lr == _GM:
-        a = 1.0
-        b = 0.0 if mem[sel_slot] == 0.0 else r
-    elif lr == _SA:
-        if kl == 0:
-            a = -1.0
-        elif kl == 1:
-            a = 1.0
-        else:
-            b = -r
-    elif lr == _SB:
-        if kl == 0:
-            b = r
-        elif kl == 1:
-            a = 1.0
-            b = r
-        else:
-            a = -1.0
-            b = -r
-    elif kl == 0:
-        a = -1.0
-    else:
-        a = -1.0
-        b = -r
+    a, b = crossed_normal(lr, kl, mem[sel_slot], r)
     # a nudge above the round-off of Y near the gap, well inside the band
     d = min(1e-12 * max(1.0, g), 1e-3 * eta) / max(1e-300, math.sqrt(a * a + b * b))
-    new = _region(Y + d * a, W + d * b, g, eta, r)
+    new = region_gap(Y + d * a, W + d * b, g, eta, r)
     if new == lr:
-        new = _region(Y + 1e3 * d * a, W + 1e3 * d * b, g, eta, r)
+        new = region_gap(Y + 1e3 * d * a, W + 1e3 * d * b, g, eta, r)
     if new == _GM:
         _set_selectors(X, V, p, mem)
         return FREE

@@ -15,7 +15,8 @@ import math
 import numba as nb
 
 from ...params import IDX
-from .switch import GAMMA_MINUS, GAMMA_PLUS, SIGMA_ALPHA, SIGMA_BETA, beta_ratio, region
+from .switch import (GAMMA_MINUS, GAMMA_PLUS, SIGMA_ALPHA, SIGMA_BETA, beta_ratio,
+                     crossed_normal, region)
 from ..oscillator import row as _row
 
 N_MEMORY = 2
@@ -109,32 +110,7 @@ def smooth_transition(mode, k, t, c, s, u, p, mem):
             mem[1] = 0.0
             return GAMMA_MINUS
     # the region just across the crossed surface: classify a point nudged outwards
-    a = 0.0  # outward normal of the crossed surface (the direction of decreasing g_k)
-    b = 0.0
-    if mode == GAMMA_MINUS:
-        a = 1.0
-        b = 0.0 if mem[1] == 0.0 else r
-    elif mode == SIGMA_ALPHA:
-        if k == 0:
-            a = -1.0
-        elif k == 1:
-            a = 1.0
-        else:
-            b = -r
-    elif mode == SIGMA_BETA:
-        if k == 0:
-            b = r
-        elif k == 1:
-            a = 1.0
-            b = r
-        else:
-            a = -1.0
-            b = -r
-    elif k == 0:
-        a = -1.0
-    else:
-        a = -1.0
-        b = -r
+    a, b = crossed_normal(mode, k, mem[1], r)
     d = 1e-12 * max(1.0, eta) / max(1e-300, math.sqrt(a * a + b * b))
     new = region(X + d * a, V + d * b, eta, r)
     if new == mode:

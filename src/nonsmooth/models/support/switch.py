@@ -64,9 +64,10 @@ def beta_ratio(omega_s, xi_s):
 
 
 @nb.njit(cache=True, inline="always")
-def region(X, V, eta, r):
-    """Region code of eq. 14 for the state (X, V)."""
-    ha = X - 1.0
+def region_gap(X, V, gap, eta, r):
+    """Region code of eq. 14 for the state (X, V) and a support at X = ``gap`` (the paper's
+    1; the ``two_sided`` model applies it to each side in that side's coordinates)."""
+    ha = X - gap
     hb = -ha - r * V
     if ha <= -eta or hb >= eta:
         return GAMMA_MINUS
@@ -75,6 +76,48 @@ def region(X, V, eta, r):
     if ha < eta and hb <= -ha:
         return SIGMA_ALPHA
     return SIGMA_BETA
+
+
+@nb.njit(cache=True, inline="always")
+def region(X, V, eta, r):
+    """Region code of eq. 14 for the state (X, V)."""
+    return region_gap(X, V, 1.0, eta, r)
+
+
+@nb.njit(cache=True, inline="always")
+def crossed_normal(mode, k, sel, r):
+    """(a, b): the outward normal, in (X, V), of the surface k of region ``mode`` whose guards
+    are the switch model's (generic description of eq. 14: Gamma- watches one inequality, the
+    one ``sel`` names (0: h_alpha <= -eta, 1: h_beta >= eta); Sigma_alpha: h_alpha + eta,
+    eta - h_alpha, r V; Sigma_beta: -r V, h_beta + eta, eta - h_beta; Gamma+: h_alpha - eta,
+    -eta - h_beta). A point nudged along it is in the region across the surface."""
+    a = 0.0
+    b = 0.0
+    if mode == GAMMA_MINUS:
+        a = 1.0
+        b = 0.0 if sel == 0.0 else r
+    elif mode == SIGMA_ALPHA:
+        if k == 0:
+            a = -1.0
+        elif k == 1:
+            a = 1.0
+        else:
+            b = -r
+    elif mode == SIGMA_BETA:
+        if k == 0:
+            b = r
+        elif k == 1:
+            a = 1.0
+            b = r
+        else:
+            a = -1.0
+            b = -r
+    elif k == 0:
+        a = -1.0
+    else:
+        a = -1.0
+        b = -r
+    return a, b
 
 
 @nb.njit(cache=True, inline="always")
