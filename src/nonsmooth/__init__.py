@@ -33,15 +33,16 @@ _LAZY = {
     "periodic_orbit": ".analysis.stability",
     "continuation": ".analysis.continuation",
     "two_parameter_curve": ".analysis.continuation",
+    "parameter_map": ".analysis.parameter_map",
     "reproduce": ".reproduction",
 }
 
 #: Subpackages and modules reachable as attributes (``ns.io``, ``ns.plot``, ...).
 _SUBMODULES = ("analysis", "cli", "errors", "integrate", "io", "kernels", "models", "params",
-               "plot", "presets", "reproduction", "status", "sweep")
+               "plot", "presets", "reproduction", "status", "sweep", "chunks")
 
 __all__ = ["__version__", "Params", "PARAM_NAMES", "model", "models", "preset", "PRESETS", "simulate", "reproduce", "Solver",
-           "eta_study", "lyapunov", "periodic_orbit", "continuation", "two_parameter_curve", "poincare", "bifurcation_diagram", "resonance_curve", "basins",
+           "eta_study", "lyapunov", "periodic_orbit", "continuation", "two_parameter_curve", "parameter_map", "poincare", "bifurcation_diagram", "resonance_curve", "basins",
            "NonsmoothError", "ParameterError", "OutputError", "IntegrationError"]
 
 

@@ -81,6 +81,20 @@ def threads(workers: int | None):
         nb.set_num_threads(old)
 
 
+@contextlib.contextmanager
+def parallel_chunks(size: int = 8):
+    """Within the block, numba's parallel loops hand out iterations in chunks of ``size``
+    (dynamic scheduling) instead of one equal share per thread: points of very unequal cost
+    (a settled point stops early, a chaotic one runs its whole transient) then keep every
+    thread busy. Only the scheduling changes, never a number."""
+    old = nb.get_parallel_chunksize()
+    nb.set_parallel_chunksize(size)
+    try:
+        yield
+    finally:
+        nb.set_parallel_chunksize(old)
+
+
 def run_trajectories(P, solver: Solver, states, *, per_period: int, n_skip: int, n_out: int,
                      workers: int | None = None, chunk: int | None = None, progress=None):
     """Integrate ``len(P)`` trajectories (rows of packed parameters ``P``, initial kernel

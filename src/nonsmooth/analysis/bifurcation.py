@@ -26,7 +26,8 @@ from ..integrate.contract import MODEL_FNS_TYPE
 from ..kernels import Solver, mode_holds, run
 from ..models.base import ParamsBase
 from ..params import check_param_name
-from .poincare import MAX_PERIOD, PERIOD_LONG_NAME, SETTLE_WINDOW, classify, settle, settle_tolerance
+from .poincare import (MAX_PERIOD, PERIOD_LONG_NAME, SETTLE_WINDOW, classify_many, settle,
+                       settle_tolerance)
 
 SWEEPS = ("up", "down", "both", "fresh")
 
@@ -188,36 +189,132 @@ def follow(P, solver: Solver, states, init, transient: int, settle_tol: float, r
     return out
 
 
+#: Values per chunk of a continuation sweep (up/down: a chunk is this many values of every
+#: direction, continued from the previous chunk's states) and of a fresh sweep (independent
+#: chunks). Chunks are the unit of resumption (``chunks``); they never change a number.
+BRANCH_CHUNK = 25
+FRESH_CHUNK = 100
+
+
 def run_branches(params: ParamsBase, param: str, values, solver: Solver, *, directions,
                  transient: int, record: int, x0: float, v0: float, settle: bool,
-                 workers=None, progress=None, chunk: int = 25):
+                 workers=None, progress=None, lyapunov: bool = False, store=None, engine=None,
+                 analysis: str = "bifurcation", fingerprint: dict | None = None):
     """Run continuation branches over sorted ``values``; ``directions`` lists "up", "down"
     or "fresh". Returns dict of arrays (branch, value, n) in ascending value order, plus
     ``status`` and ``used`` (branch, value), ``S`` the kernel state after each value
-    (branch, value, 5) and the final ``state`` per branch.
+    (branch, value, 5), the classification of :func:`summarize` (``period``, ``max_X``,
+    ``min_X``, ``contact``), with ``lyapunov`` ``lambda1``, ``lambda1_stderr`` and ``motion``,
+    and the final ``state`` per branch.
+
+    The values are computed in chunks (:data:`BRANCH_CHUNK` values of every direction, each
+    chunk continued from the states the previous one ended with; a fresh sweep in independent
+    chunks of :data:`FRESH_CHUNK`) by ``engine`` (``chunks.execute``); with ``store`` (a
+    directory) finished chunks are written there and a re-run resumes from them.
     ``progress(done, total)`` is called after each time slice (see :func:`follow`)."""
+    from ..chunks import Plan, chunk_bounds, execute, plan_solver
     from ..kernels import new_state
     values = np.asarray(values, dtype=np.float64)
     nv = values.size
     rows = param_rows(params, param, values)
     init = new_state(x0, v0)
     fresh = list(directions) == ["fresh"]
+    orders = [np.arange(nv) if d != "down" else np.arange(nv)[::-1] for d in directions]
+    bounds = chunk_bounds(nv, FRESH_CHUNK if fresh else BRANCH_CHUNK)
+    spec = {"solver": plan_solver(solver, engine), "rows": rows, "orders": orders,
+            "fresh": fresh, "init": init, "transient": int(transient), "record": int(record),
+            "settle_tol": settle_tolerance(solver, settle), "lyapunov": bool(lyapunov),
+            "bounds": bounds}
+    nbr = 1 if fresh else len(directions)
+    plan = Plan(analysis, {**(fingerprint or {}), "param": param, "values": values,
+                           "directions": list(directions), "transient": transient,
+                           "record": record, "x0": x0, "v0": v0, "settle": bool(settle),
+                           "lyapunov": bool(lyapunov), "params": rows[0],
+                           "solver": spec["solver"], "chunk": bounds[0][1] - bounds[0][0]},
+                len(bounds), _branch_chunk, spec, chained=not fresh,
+                weights=[(b - a) * nbr * (transient + record) for a, b in bounds])
+    out = {}
+
+    def collect(i, res):
+        a, b = bounds[i]
+        if not out:
+            for k, v in res.items():
+                if k != "carry":
+                    out[k] = np.empty((nbr, nv) + v.shape[2:], v.dtype)
+        for k, v in res.items():
+            if k == "carry":
+                out["state"] = v
+            elif fresh:
+                out[k][0, a:b] = v[:, 0]
+            else:
+                for j, o in enumerate(orders):
+                    out[k][j, o[a:b]] = v[j]
+    execute(plan, collect, store=store, engine=engine, workers=workers, progress=progress)
     if fresh:
-        # every value is its own one-point branch, all in parallel
-        P = rows[:, None, :]
-        orders = [np.arange(nv)]
+        out["state"] = out["S"][0].copy()
+    return out
+
+
+def _branch_chunk(spec, i, carry, workers=None, progress=None):
+    """Chunk ``i`` of :func:`run_branches` (a ``chunks.Plan`` task)."""
+    from ..chunks import solver_from_spec
+    solver = solver_from_spec(spec["solver"])
+    a, b = spec["bounds"][i]
+    rows, init = spec["rows"], spec["init"]
+    if spec["fresh"]:
+        P = np.ascontiguousarray(rows[a:b][:, None, :])
     else:
-        orders = [np.arange(nv) if d == "up" else np.arange(nv)[::-1] for d in directions]
-        P = np.ascontiguousarray(np.stack([rows[o] for o in orders]))  # (branch, value, 7)
-    states = np.tile(init, (P.shape[0], 1))
-    out = follow(P, solver, states, init, transient, settle_tolerance(solver, settle), record,
-                 workers=workers, progress=progress, group=4 * chunk if fresh else None)
-    if fresh:
-        out = {k: np.moveaxis(a, 0, 1) for k, a in out.items()}  # (1, value, ...)
-    else:
-        for k, a in out.items():
-            out[k] = np.stack([a[j][np.argsort(o)] for j, o in enumerate(orders)])
-    out["state"] = states
+        P = np.ascontiguousarray(np.stack([rows[o[a:b]] for o in spec["orders"]]))
+    states = (np.array(carry, dtype=np.float64, copy=True) if carry is not None
+              else np.tile(init, (P.shape[0], 1)))
+    out = sweep_block(P, solver, states, init, spec["transient"], spec["settle_tol"],
+                      spec["record"], spec["lyapunov"], workers=workers, progress=progress)
+    if spec["fresh"]:
+        del out["carry"]  # independent chunks; results (value, 1, ...)
+    return out
+
+
+def sweep_block(P, solver: Solver, states, init, transient: int, settle_tol: float, record: int,
+                lyapunov: bool = False, *, floquet: bool = False, workers=None,
+                progress=None) -> dict:
+    """:func:`follow` over packed parameters ``P`` (branch, value, n_par) from ``states``
+    (branch, 5), then :func:`summarize` (``period``, ``max_X``, ``min_X``, ``contact``) and,
+    with ``lyapunov``, ``lambda1``, ``lambda1_stderr``, ``motion`` per point (over ``record``
+    further periods of its attractor, ``analysis.stability.lambda1_points``; with ``floquet``
+    a periodic point's lambda1 is ln|mu_1| / (p T) of its leading Floquet multiplier instead,
+    with stderr 0, ``stability.floquet_lambda1_points``). ``carry``: the states after the last
+    value of each branch. Parallel loops are scheduled dynamically (``sweep.parallel_chunks``)."""
+    from ..sweep import parallel_chunks
+    with parallel_chunks():
+        out = follow(P, solver, states, init, transient, settle_tol, record, workers=workers,
+                     progress=progress)
+        out["carry"] = states.copy()
+        period, mx, mn, contact = summarize(out, P, solver, transient, record, workers)
+        out.update(period=period, max_X=mx, min_X=mn, contact=contact)
+        if lyapunov:
+            from .stability import classify_points, floquet_lambda1_points, lambda1_points
+            nb_, nv = period.shape
+            flat_P, flat_S = P.reshape(nb_ * nv, -1), out["S"].reshape(nb_ * nv, -1)
+            per = period.ravel()
+            lam = np.full(nb_ * nv, np.nan)
+            err = np.full(nb_ * nv, np.nan)
+            periodic = np.flatnonzero(per > 0) if floquet else np.zeros(0, np.int64)
+            rest = np.setdiff1d(np.arange(nb_ * nv), periodic)
+            if periodic.size:
+                lam[periodic] = floquet_lambda1_points(flat_P[periodic], solver,
+                                                       flat_S[periodic], per[periodic],
+                                                       workers=workers)[0]
+                err[periodic] = np.where(np.isfinite(lam[periodic]), 0.0, np.nan)
+            if rest.size:
+                lam[rest], err[rest], _ = lambda1_points(flat_P[rest], solver, flat_S[rest],
+                                                         record, workers=workers)
+            lam, err = lam.reshape(nb_, nv), err.reshape(nb_, nv)
+            failed = out["status"] != st.OK
+            lam[failed] = np.nan
+            err[failed] = np.nan
+            motion = classify_points(lam, err, period)
+            motion[failed] = 0
+            out.update(lambda1=lam, lambda1_stderr=err, motion=motion)
     return out
 
 
@@ -233,42 +330,49 @@ MAX_ROUNDS = 3
 
 
 def summarize(out, rows, solver: Solver, transient: int, record: int, workers=None):
-    """period, max_X, min_X, contact per (branch, value) of ``out`` (ascending value order,
-    ``rows[i]`` the packed parameters of value i). Sections still converging are extended
+    """period, max_X, min_X, contact per (branch, value) of ``out``; ``rows``: the packed
+    parameters, (value, n_par) shared by the branches or (branch, value, n_par). Sections still converging are extended
     first (see MAX_EXTENSION): their data in ``out`` (X ... Xmin, ``used``: the periods
     before the recorded window, ``S``) are replaced by the later window."""
     shape = out["status"].shape
+    rows = np.asarray(rows)
+    if rows.ndim == 2:
+        rows = np.broadcast_to(rows[None], (shape[0],) + rows.shape)
     period = np.zeros(shape, np.int64)
     mx = np.full(shape, np.nan)
     mn = np.full(shape, np.nan)
     contact = np.zeros(shape, np.int8)
     cap = MAX_EXTENSION * max(transient, record)
     extra = np.zeros(shape, np.int64)
-    todo = [(j, i) for j in range(shape[0]) for i in range(shape[1])
-            if out["status"][j, i] == st.OK]
+    todo = [tuple(q) for q in np.argwhere(out["status"] == st.OK).tolist()]
     model = solver.model
-    predicates = {}
 
-    def contact_rule(i):  # the model's contact predicate at parameter row i
-        if i not in predicates:
-            prm = model.params(**dict(zip(model.param_names, map(float, rows[i]))))
-            predicates[i] = lambda m, a, b: model.is_contact(prm, m, a, b)
-        return predicates[i]
+    def is_contact(row, m, a, b):  # the model's contact predicate at the packed ``row``
+        return model.is_contact(_LazyParams(model, row), m, a, b)
 
     for rnd in range(MAX_ROUNDS + 1):
         pending = {}  # extension (a power of 2 periods, at least ``record``) -> points
-        for j, i in todo:
-            period[j, i], mx[j, i], mn[j, i], contact[j, i], need = classify(
-                out["X"][j, i], out["V"][j, i], out["Xmax"][j, i], out["Xmin"][j, i],
-                out["M"][j, i], solver.rtol, solver.atol, contact=contact_rule(i))
-            if need > 0 and rnd < MAX_ROUNDS and extra[j, i] + record + need <= cap:
+        jj = np.array([q[0] for q in todo], np.int64)
+        ii = np.array([q[1] for q in todo], np.int64)
+        c_per, c_mx, c_mn, c_mask, c_need, c_ok = classify_many(
+            out["X"][jj, ii], out["V"][jj, ii], out["Xmax"][jj, ii], out["Xmin"][jj, ii],
+            out["M"][jj, ii], solver.rtol, solver.atol)
+        period[jj, ii], mx[jj, ii], mn[jj, ii], contact[jj, ii] = c_per, c_mx, c_mn, 0
+        for k in np.flatnonzero(c_ok).tolist():
+            j, i = todo[k]
+            contact[j, i] = int(bool(is_contact(rows[j, i], int(c_mask[k]), float(c_mx[k]),
+                                                float(c_mn[k]))))
+        for k in np.flatnonzero(c_need > 0).tolist():
+            j, i = todo[k]
+            need = float(c_need[k])
+            if rnd < MAX_ROUNDS and extra[j, i] + record + need <= cap:
                 ext = max(record, 1 << int(math.ceil(math.log2(1.5 * need))))
                 ext = min(ext, cap - int(extra[j, i]) - record)
                 pending.setdefault(ext, []).append((j, i))
         for ext, points in pending.items():
             idx = tuple(np.array(points).T)
             states = out["S"][idx].copy()
-            res = follow(np.ascontiguousarray(rows[idx[1]][:, None, :]), solver, states,
+            res = follow(np.ascontiguousarray(rows[idx][:, None, :]), solver, states,
                          states[0].copy(), ext, settle_tolerance(solver, True), record,
                          workers=workers)
             for k, (j, i) in enumerate(points):
@@ -285,12 +389,28 @@ def summarize(out, rows, solver: Solver, transient: int, record: int, workers=No
     return period, mx, mn, contact
 
 
+class _LazyParams:
+    """The model's validated parameters at a packed row, built only if a contact predicate
+    reads one (most read none: building them for every point of a map costs more than
+    classifying it)."""
+
+    def __init__(self, model, row):
+        self._model, self._row, self._params = model, row, None
+
+    def __getattr__(self, name):
+        if self._params is None:
+            m = self._model
+            self._params = m.params(**dict(zip(m.param_names, map(float, self._row))))
+        return getattr(self._params, name)
+
+
 def bifurcation_diagram(params: ParamsBase, param: str, values, *, sweep: str = "both",
                         transient: int = 500, record: int = 200, method: str = "smooth",
                         x0: float = 0.0, v0: float = 0.0, rtol: float = 1e-8,
                         atol: float = 1e-10, transition: str = "eq13", settle: bool = True,
                         max_steps: int = 200_000, workers: int | None = None,
-                        progress=None, lyapunov: bool | None = None) -> xr.Dataset:
+                        progress=None, lyapunov: bool | None = None, store=None,
+                        engine=None) -> xr.Dataset:
     """Orbit diagram of the stroboscopic section over ``param`` (any of omega, F0, omega_s,
     xi, xi_s, omega0, eta) at ``values`` (sorted ascending; each validated by Params).
 
@@ -313,9 +433,15 @@ def bifurcation_diagram(params: ParamsBase, param: str, values, *, sweep: str = 
     ``lyapunov`` (None = where tangent dynamics exist, i.e. not for eq. 12): also ``lambda1`` with ``lambda1_stderr`` (over ``record`` further periods
     of each point's attractor) and the verdict ``motion`` (periodic / quasi-periodic /
     chaotic / not settled; see ``analysis.stability.classify``).
+    ``store``: a directory where finished chunks are written as they finish; running the same
+    sweep with the same store again resumes (see ``nonsmooth.chunks``). ``engine``: None (all
+    local cores), "local[:N]" (a Dask LocalCluster), a Dask scheduler address or a
+    ``dask.distributed.Client``; the numbers do not depend on it.
     """
+    from ..chunks import check_engine
     from ..simulate import check_float, check_int, check_params
     params = check_params(params)
+    engine = check_engine(engine)
     if not isinstance(param, str):
         raise ParameterError(f"param: expected a parameter name, got {param!r}")
     param = check_param_name(param, params)
@@ -330,42 +456,32 @@ def bifurcation_diagram(params: ParamsBase, param: str, values, *, sweep: str = 
     solver = Solver(model=params.model, method=method, rtol=rtol, atol=atol, transition=transition,
                     max_steps=max_steps)
     directions = {"up": ["up"], "down": ["down"], "both": ["up", "down"], "fresh": ["fresh"]}[sweep]
+    from .stability import wants_lyapunov
     out = run_branches(params, param, values, solver, directions=directions,
                        transient=transient, record=record, x0=x0, v0=v0, settle=settle,
-                       workers=workers, progress=progress)
+                       workers=workers, progress=progress,
+                       lyapunov=wants_lyapunov(lyapunov, solver), store=store, engine=engine)
     return branches_dataset(params, param, values, solver, directions, out,
                             analysis="bifurcation", transient=transient, record=record,
-                            x0=x0, v0=v0, settle=settle, sweep_mode=sweep, workers=workers,
-                            lyapunov=lyapunov)
+                            x0=x0, v0=v0, settle=settle, sweep_mode=sweep)
 
 
 #: Integer codes of the ``sweep`` coordinate (CF flag_values / flag_meanings).
 SWEEP_CODES = {"up": 0, "down": 1, "fresh": 2}
 
 
-def branches_dataset(params, param, values, solver, directions, out, *, workers=None,
-                     lyapunov: bool | None = False, **attrs) -> xr.Dataset:
-    """The Dataset of :func:`run_branches` output (classified by :func:`summarize`; with
-    ``lyapunov``, lambda1 and ``motion`` from ``analysis.stability.lyapunov_variables``)."""
+def branches_dataset(params, param, values, solver, directions, out, **attrs) -> xr.Dataset:
+    """The Dataset of :func:`run_branches` output (with ``lambda1`` and ``motion`` where
+    it has them)."""
     from ..io import flag_attrs, status_flags
-    rows = param_rows(params, param, values)
-    period, mx, mn, contact = summarize(out, rows, solver, attrs["transient"], attrs["record"],
-                                        workers)
+    from .stability import lyapunov_attrs
+    period, mx, mn, contact = out["period"], out["max_X"], out["min_X"], out["contact"]
     spec = params.model.param(param)
     desc, unit = spec.long_name, spec.units
     dims = ("sweep", param)
     nfail = int(np.count_nonzero(out["status"]))
-    extra = {}
-    from .stability import lyapunov_variables, wants_lyapunov
-    if wants_lyapunov(lyapunov, solver):
-        nb_, nv = period.shape
-        P = np.ascontiguousarray(np.broadcast_to(rows[None], (nb_, nv, rows.shape[1]))
-                                 .reshape(nb_ * nv, -1))
-        extra = lyapunov_variables(P, solver, out["S"].reshape(nb_ * nv, -1), attrs["record"],
-                                   period, dims)
-        failed = out["status"] != st.OK
-        extra["lambda1"][1][failed] = np.nan
-        extra["motion"][1][failed] = 0
+    extra = {k: (dims, out[k], a) for k, a in lyapunov_attrs(attrs["record"]).items()
+             if k in out}
     ds = xr.Dataset(
         {
             "X": (dims + ("n",), out["X"], {"long_name": "section displacement X(kT)",

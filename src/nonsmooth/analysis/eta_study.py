@@ -108,12 +108,38 @@ def _integrate(P, solver, x0, v0, transient, record, orbit_periods, spp, workers
     return sec, por, status
 
 
+#: Band half-widths per chunk (the unit of resumption, ``nonsmooth.chunks``); the exact
+#: model is a chunk of its own.
+ETA_CHUNK = 8
+
+
+def _eta_chunk(spec, i, carry, workers=None, progress=None):
+    """Chunk ``i`` of :func:`eta_study` (a ``chunks.Plan`` task): section, orbit and status
+    of a block of etas (smoothed model), or of the exact model (the last chunk)."""
+    from ..chunks import solver_from_spec
+    bounds = spec["bounds"]
+    if i < len(bounds):
+        a, b = bounds[i]
+        P, solver = spec["P"][a:b], solver_from_spec(spec["smooth"])
+    else:
+        P, solver = spec["p"][None, :], solver_from_spec(spec["exact"])
+    total = P.shape[0] * (spec["transient"] + spec["record"] + spec["orbit_periods"])
+
+    def stage(offset):
+        return None if progress is None else (lambda d, _t: progress(offset + d, total))
+    sec, por, status = _integrate(P, solver, spec["x0"], spec["v0"], spec["transient"],
+                                  spec["record"], spec["orbit_periods"], spec["spp"], workers,
+                                  stage)
+    return {"sX": sec["X"], "sV": sec["V"], "sM": sec["M"], "oX": por["X"], "oV": por["V"],
+            "oR": por["R"], "oM": por["M"], "status": np.asarray(status, np.int64)}
+
+
 def eta_study(params: ParamsBase, etas, *, transient: int = 300, record: int | None = None,
               orbit_periods: int | None = None, samples_per_period: int = 200, x0: float = 0.0,
               v0: float = 0.0, rtol: float = 1e-8, atol: float = 1e-10,
               distance_tol: float = 1e-3, transition: str = "eq13",
               workers: int | None = None, progress=None, points: int | None = None,
-              portrait_periods: int | None = None) -> xr.Dataset:
+              portrait_periods: int | None = None, store=None, engine=None) -> xr.Dataset:
     """Audit the band half-width eta of the smoothed model against the exact model.
 
     From (x0, v0), every eta (smoothed model) and the exact model integrate ``transient``
@@ -133,7 +159,11 @@ def eta_study(params: ParamsBase, etas, *, transient: int = 300, record: int | N
       ``exact_period``, ``exact_reaches_gamma_plus``, ``exact_status``,
       ``exact_self_distance``;
     * ``recommended_eta``: the largest eta that agrees with the exact model (NaN if none).
+
+    ``store`` / ``engine``: chunked, resumable runs (:data:`ETA_CHUNK` etas per chunk, the
+    exact model one more) and where they run (see ``nonsmooth.chunks``).
     """
+    from ..chunks import Plan, check_engine, chunk_bounds, execute, plan_solver
     from ..io import check_memory, flag_attrs, status_flags
     from ..simulate import check_params
     from ..simulate import renamed
@@ -163,18 +193,28 @@ def eta_study(params: ParamsBase, etas, *, transient: int = 300, record: int | N
                     model=params.model)
     exact = Solver(method="exact", model=params.model)
 
-    total = (n + 1) * (transient + record + orbit_periods)
-
-    def stage(offset):
-        return None if progress is None else (lambda d, _t: progress(offset + d, total))
-
+    engine = check_engine(engine)
     P = np.stack([params.replace(eta=float(e)).pack() for e in eta_vals])
-    sec, por, status = _integrate(P, smooth, float(x0), float(v0), transient, record,
-                                  orbit_periods, spp, workers, stage)
-    done = n * (transient + record + orbit_periods)
-    esec, epor, estatus = _integrate(params.pack()[None, :], exact, float(x0), float(v0),
-                                     transient, record, orbit_periods, spp, workers,
-                                     lambda o: stage(done + o))
+    bounds = chunk_bounds(n, ETA_CHUNK)
+    spec = {"P": P, "p": params.pack(), "smooth": plan_solver(smooth, engine),
+            "exact": plan_solver(exact, engine), "bounds": bounds, "x0": float(x0),
+            "v0": float(v0), "transient": transient, "record": record,
+            "orbit_periods": orbit_periods, "spp": spp}
+    per = transient + record + orbit_periods
+    plan = Plan("eta_study", {k: v for k, v in spec.items() if k != "bounds"} | {
+        "etas": eta_vals, "chunk": ETA_CHUNK}, len(bounds) + 1, _eta_chunk, spec,
+        weights=[(b - a) * per for a, b in bounds] + [per])
+    parts = {}
+    execute(plan, lambda i, res: parts.__setitem__(i, res), store=store, engine=engine,
+            workers=workers, progress=progress)
+    smooth_parts = [parts[i] for i in range(len(bounds))]
+    sec = {k: np.concatenate([r["s" + k] for r in smooth_parts]) for k in "XVM"}
+    por = {k: np.concatenate([r["o" + k] for r in smooth_parts]) for k in "XVRM"}
+    status = np.concatenate([r["status"] for r in smooth_parts])
+    ex = parts[len(bounds)]
+    esec = {"X": ex["sX"], "V": ex["sV"], "M": ex["sM"]}
+    epor = {"X": ex["oX"], "V": ex["oV"], "R": ex["oR"]}
+    estatus = ex["status"]
     om = params.omega
 
     # ---- exact reference ----

@@ -167,7 +167,7 @@ def resonance_curve(params: ParamsBase, omegas, *, method: str = "smooth", trans
                     atol: float = 1e-10, transition: str = "eq13", settle: bool = True,
                     resolution: float = 1e-4, branch_tol: float = 1e-3,
                     workers: int | None = None, progress=None,
-                    branches: str = "stable") -> xr.Dataset:
+                    branches: str = "stable", store=None, engine=None) -> xr.Dataset:
     """Resonance curve over the forcing frequencies ``omegas`` (sorted ascending), swept up and
     down with continuation (see :func:`.bifurcation.bifurcation_diagram` for transient, record,
     settle). Returns a Dataset over (sweep, omega) with ``max_X``, ``min_X``, ``period``,
@@ -181,9 +181,15 @@ def resonance_curve(params: ParamsBase, omegas, *, method: str = "smooth", trans
     ``branch_min_X``, ``branch_stable`` over ``branch_point``, and the attrs
     ``omega_a_continuation`` (the first grazing), ``omega_c_continuation`` and
     ``omega_b_continuation`` (the upper and the lower fold), located to 1e-10 instead of by
-    sweeps (a sweep near a fold lingers on the vanishing orbit, so its jump comes late)."""
+    sweeps (a sweep near a fold lingers on the vanishing orbit, so its jump comes late).
+
+    ``store`` / ``engine``: chunked, resumable sweeps and where they run, as for
+    :func:`.bifurcation.bifurcation_diagram` (the refinement of the characteristic
+    frequencies runs locally after the sweeps)."""
+    from ..chunks import check_engine
     from ..simulate import check_float, check_int, check_params
     params = check_params(params)
+    engine = check_engine(engine)
     transient = check_int("transient", transient, 0)
     record = check_int("record", record, 1)
     check_sweep_memory(np.size(omegas), 2, record)
@@ -205,14 +211,15 @@ def resonance_curve(params: ParamsBase, omegas, *, method: str = "smooth", trans
                     model=params.model)
     out = run_branches(params, w_name, omegas, solver, directions=["up", "down"],
                        transient=transient, record=record, x0=x0, v0=v0, settle=settle,
-                       workers=workers, progress=progress)
+                       workers=workers, progress=progress, store=store, engine=engine,
+                       analysis="resonance")
     freqs = characteristic_frequencies(params, solver, omegas, out, transient=transient,
                                        record=record, settle=settle, workers=workers,
                                        resolution=resolution, branch_tol=branch_tol)
     ds = branches_dataset(params, w_name, omegas, solver, ["up", "down"], out,
                           analysis="resonance", transient=transient, record=record, x0=x0,
                           v0=v0, settle=settle, resolution=resolution, branch_tol=branch_tol,
-                          workers=workers, **freqs)
+                          **freqs)
     if branches == "all":
         _all_branches(ds, params, w_name, omegas, out, method)
     return ds

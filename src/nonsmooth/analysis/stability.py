@@ -425,6 +425,59 @@ def lambda1_points(P, solver, states, periods: int, *, blocks: int = 10, workers
     return lam, err, status
 
 
+@nb.njit(cache=True, parallel=True)
+def _monodromy_many(fns, P, opts, states, k, N, cmi, mono, status):
+    """The monodromy (N x N) of the k[i]-fold period map from each ``states[i]`` (tangent
+    kernel, no re-orthonormalisation); status[i] the kernel status."""
+    for i in nb.prange(P.shape[0]):
+        Y = np.eye(N)
+        m = k[i]
+        X = np.empty(m)
+        V = np.empty(m)
+        R = np.empty(m, np.int8)
+        M = np.empty(m, np.uint8)
+        Xa = np.empty(m)
+        Xb = np.empty(m)
+        status[i] = advance_tangent(fns, P[i], opts, states[i], 1, 0, m, X, V, R, M, Xa, Xb,
+                                    Y, np.zeros((0, 0)), cmi, 0)
+        for a in range(N):
+            for b in range(N):
+                mono[i, a, b] = Y[a, b]
+
+
+def floquet_lambda1_points(P, solver, states, period, *, workers=None):
+    """lambda1 = ln|mu_1| / (p T) of points on periodic orbits (period ``p`` > 0 each, kernel
+    ``states`` on the orbit at a period boundary): the leading Floquet multiplier of the
+    p-fold map, from one pass of the tangent kernel over p periods (``_active`` coordinates:
+    memory slots the map does not depend on are left out). Returns (lambda1, status)."""
+    from ..sweep import threads
+    setup = TangentSetup(solver)
+    P = np.array(np.atleast_2d(P), dtype=np.float64, order="C")
+    S = np.array(states, dtype=np.float64, copy=True).reshape(P.shape[0], -1)
+    if solver.code != KERNEL_GENERIC:
+        S[:, ST_MODE] = -1.0
+        S[:, ST_H] = 0.0
+    k = np.asarray(period, dtype=np.int64).ravel()
+    n = P.shape[0]
+    mono = np.zeros((n, setup.N, setup.N))
+    status = np.zeros(n, np.int64)
+    with threads(workers):
+        _monodromy_many(setup.fns, P, setup.opts, S, k, setup.N, setup.cmi, mono, status)
+    lam = np.full(n, np.nan)
+    om = P[:, solver.model.index[solver.model.omega]]
+    T = 2.0 * np.pi / om
+    ok = status == st.OK
+    groups = {}
+    for i in np.flatnonzero(ok).tolist():
+        groups.setdefault(tuple(_active(mono[i], setup.n)), []).append(i)
+    for act, idx in groups.items():
+        a = np.flatnonzero(act)
+        sub = mono[np.ix_(idx, a, a)]
+        with np.errstate(divide="ignore"):
+            lam[idx] = np.log(np.abs(np.linalg.eigvals(sub)).max(axis=1)) / (k[idx] * T[idx])
+    return lam, status
+
+
 def classify_points(lam, err, period) -> np.ndarray:
     """:func:`classify` over arrays (period -1: not settled)."""
     lam = np.asarray(lam, dtype=float)
@@ -469,11 +522,19 @@ def lyapunov_variables(P, solver, states, periods: int, period, dims) -> dict:
     motion = classify_points(lam, err, period)
     if not dims:
         lam, err, motion = float(lam[0]), float(err[0]), np.int8(motion[0])
+    attrs = lyapunov_attrs(periods)
+    return {"lambda1": (dims, lam, attrs["lambda1"]),
+            "lambda1_stderr": (dims, err, attrs["lambda1_stderr"]),
+            "motion": (dims, motion, attrs["motion"])}
+
+
+def lyapunov_attrs(periods: int) -> dict:
+    """CF attributes of the ``lambda1``, ``lambda1_stderr`` and ``motion`` variables of a
+    sweep (lambda1 over ``periods`` periods per point)."""
     return {
-        "lambda1": (dims, lam, {"long_name": "largest Lyapunov exponent (tangent dynamics with "
-                                             "saltation matrices)", "units": "1/s",
-                                "periods": periods}),
-        "lambda1_stderr": (dims, err, {"long_name": "standard error of lambda1 (10 block "
-                                                    "means)", "units": "1/s"}),
-        "motion": (dims, motion, motion_attrs()),
+        "lambda1": {"long_name": "largest Lyapunov exponent (tangent dynamics with saltation "
+                                 "matrices)", "units": "1/s", "periods": periods},
+        "lambda1_stderr": {"long_name": "standard error of lambda1 (10 block means)",
+                           "units": "1/s"},
+        "motion": motion_attrs(),
     }

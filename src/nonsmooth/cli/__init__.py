@@ -24,6 +24,7 @@ from . import basins  # noqa: E402,F401
 from . import models  # noqa: E402,F401
 from . import stability  # noqa: E402,F401
 from . import continuation  # noqa: E402,F401
+from . import parameter_map  # noqa: E402,F401
 
 def _terminate(signum, frame):
     raise Terminated()
@@ -48,11 +49,26 @@ def interrupted_message(code: int) -> str:
         lost += "; " + ", ".join(f"{p} {'untouched' if p.exists() else 'not written'}"
                                  for p in untouched)
     what = "interrupted" if code == EXIT_INTERRUPTED else "terminated"
+    from ..chunks import interrupted_stores
+    if interrupted_stores:
+        path, done, total = interrupted_stores[-1]
+        chunks = f"{done} of {total} chunks in {path}"
+        saved = chunks if saved == "nothing" else f"{saved}, {chunks}"
+        lost = ("the chunks in progress" + lost.removeprefix(
+            "the computation in progress; no partial result written") +
+            "; run the same command again to resume")
     return f"{what}: saved {saved}; lost {lost}"
 
 
+def _resume_notice(path, done: int, total: int) -> None:
+    typer.echo(f"resuming from {path}: {done} of {total} chunks already done", err=True)
+
+
 def main(argv: list[str] | None = None) -> None:
+    from .. import chunks
     planned.clear()
+    chunks.interrupted_stores.clear()
+    chunks.on_resume = _resume_notice
     previous = signal.signal(signal.SIGTERM, _terminate)
     _numba_cache.compile_notice = _compile_notice
     try:
@@ -69,3 +85,4 @@ def main(argv: list[str] | None = None) -> None:
     finally:  # leave a calling process (tests, a notebook) as it was
         signal.signal(signal.SIGTERM, previous)
         _numba_cache.compile_notice = None
+        chunks.on_resume = None

@@ -9,8 +9,8 @@ import typer
 
 from ..errors import ParameterError
 from .app import app
-from .common import (AtolOpt, MethodOpt, ModelOpt, OutOpt, PlotOpt, PresetOpt, RtolOpt, SetOpt,
-                     TransitionOpt, WorkersOpt, check_outputs, echo_written, load_params,
+from .common import (AtolOpt, DaskOpt, MethodOpt, ModelOpt, OutOpt, PlotOpt, PresetOpt, RtolOpt, SetOpt,
+                     TransitionOpt, WorkersOpt, check_outputs, chunk_store, echo_written, load_params,
                      preset_label, require_output, resolve_method, save_outputs)
 
 FromOpt = Annotated[float, typer.Option("--from", help="first value of the range")]
@@ -130,6 +130,7 @@ def bifurcation_cmd(
     transition: TransitionOpt = "eq13",
     settle: SettleOpt = True,
     workers: WorkersOpt = None,
+    dask: DaskOpt = None,
     out: OutOpt = None,
     plot: PlotOpt = None,
 ):
@@ -151,11 +152,12 @@ def bifurcation_cmd(
     check_int("record", record, 1)
     require_output(out, plot)
     check_outputs(out, plot)
+    store, engine = chunk_store(out, dask)
     with _progress(f"bifurcation {param} ({sweep})") as prog:
         ds = bifurcation_diagram(params, param, values, sweep=sweep, transient=transient,
                                  record=record, method=method, x0=x0, v0=v0, rtol=rtol,
                                  atol=atol, transition=transition, settle=settle,
-                                 workers=workers, progress=prog)
+                                 workers=workers, progress=prog, store=store, engine=engine)
     from ..plot.bifurcation import plot_bifurcation
     save_outputs(ds, preset, out, plot, plot_bifurcation)
     typer.echo(f"{preset}: {param} {from_:g} ... {to:g}, {steps} values, sweep {sweep}: "
@@ -185,6 +187,7 @@ def resonance_cmd(
         "--all", help="also every period-1 branch, stable and unstable, by continuation, with "
                       "omega_a (grazing), omega_b, omega_c (folds) located on it")] = False,
     workers: WorkersOpt = None,
+    dask: DaskOpt = None,
     out: OutOpt = None,
     plot: PlotOpt = None,
 ):
@@ -204,11 +207,13 @@ def resonance_cmd(
     check_int("record", record, 1)
     require_output(out, plot)
     check_outputs(out, plot)
+    store, engine = chunk_store(out, dask)
     with _progress("resonance (up and down)") as prog:
         ds = resonance_curve(params, omegas, method=method, transient=transient, record=record,
                              x0=x0, v0=v0, rtol=rtol, atol=atol, transition=transition,
                              settle=settle, resolution=resolution, workers=workers,
-                             progress=prog, branches="all" if all_branches else "stable")
+                             progress=prog, branches="all" if all_branches else "stable",
+                             store=store, engine=engine)
     from ..plot.resonance import plot_resonance
     save_outputs(ds, preset, out, plot, plot_resonance)
     a = ds.attrs

@@ -8,8 +8,8 @@ from typing import Annotated, Optional
 import typer
 
 from .app import app
-from .common import (AtolOpt, MethodOpt, ModelOpt, OutOpt, PlotOpt, PresetOpt, RtolOpt, SetOpt,
-                     TransitionOpt, WorkersOpt, check_outputs, echo_written, load_params,
+from .common import (AtolOpt, DaskOpt, MethodOpt, ModelOpt, OutOpt, PlotOpt, PresetOpt, RtolOpt, SetOpt,
+                     TransitionOpt, WorkersOpt, check_outputs, chunk_store, echo_written, load_params,
                      preset_label, require_output, resolve_method, save_outputs)
 
 
@@ -30,6 +30,7 @@ def basins_cmd(
     atol: AtolOpt = 1e-10,
     transition: TransitionOpt = "eq13",
     workers: WorkersOpt = None,
+    dask: DaskOpt = None,
     out: OutOpt = None,
     plot: PlotOpt = None,
     orbits_plot: Annotated[Optional[Path], typer.Option("--orbits-plot", help="figure of the coexisting orbits (Fig. 8)")] = None,
@@ -47,12 +48,13 @@ def basins_cmd(
     preset = preset_label(params, preset, "fig7")
     require_output(out, plot if plot is not None else orbits_plot)
     check_outputs(out, plot, orbits_plot=orbits_plot)
+    store, engine = chunk_store(out, dask)
     with Progress("basins") as bar, warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always", UserWarning)
         ds = basins(params, x=x, v=v, grid=grid, method=method, transient=transient,
                     max_periods=max_periods, max_period=max_period, rtol=rtol, atol=atol,
                     transition=transition, early_stop=not no_early_stop, workers=workers,
-                    progress=bar)
+                    progress=bar, store=store, engine=engine)
     from ..plot.basins import plot_basins
     save_outputs(ds, preset, out, plot, plot_basins)
     if orbits_plot is not None:

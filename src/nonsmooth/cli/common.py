@@ -34,6 +34,10 @@ RtolOpt = Annotated[float, typer.Option("--rtol", help="relative tolerance")]
 AtolOpt = Annotated[float, typer.Option("--atol", help="absolute tolerance")]
 TransitionOpt = Annotated[str, typer.Option("--transition", help="eq13 (paper, default) or eq12 (convex)")]
 WorkersOpt = Annotated[Optional[int], typer.Option("--workers", "-j", help="threads (default: all cores)")]
+DaskOpt = Annotated[Optional[str], typer.Option(
+    "--dask", show_default=False,
+    help="run the chunks on a Dask cluster: a scheduler address (tcp://host:8786), or local "
+         "/ local:N to start N local worker processes; default: this machine's cores")]
 
 
 #: Output paths this run was asked for -> the file each is written to (a figure without
@@ -130,14 +134,25 @@ def require_output(out: Path | None, plot: Path | None) -> None:
         raise ParameterError("output: give -o FILE.nc and/or --plot FILE.png")
 
 
+def chunk_store(out: Path | None, dask: str | None = None):
+    """The chunk store of a sweep written to ``out`` (``<out>.chunks``: finished chunks are
+    kept there until the result file is written, and a re-run with the same ``-o`` resumes
+    from them; none without ``-o``) and the checked ``--dask`` engine."""
+    from ..chunks import check_engine, store_for
+    return store_for(out), check_engine(dask)
+
+
 def save_outputs(ds, preset: str, out: Path | None, plot: Path | None, figure=None) -> None:
     """Record the preset, write the netCDF file and render ``figure(ds)`` (a plot function:
-    Dataset in, Figure out) to ``plot`` where asked (each file written atomically)."""
+    Dataset in, Figure out) to ``plot`` where asked (each file written atomically). Once the
+    result file is written, the run's chunk store (:func:`chunk_store`) is removed."""
     from ..io import save_dataset, save_figure
 
     ds.attrs["preset"] = preset
     if out is not None:
         save_dataset(ds, out)
+        from ..chunks import remove_store, store_for
+        remove_store(store_for(out))
     if plot is not None and figure is not None:
         save_figure(figure(ds), plot)
 

@@ -9,8 +9,8 @@ import typer
 from ..errors import ParameterError
 from .app import app
 from .analyses import HiddenIntOpt, _progress
-from .common import (AtolOpt, ModelOpt, OutOpt, PlotOpt, PresetOpt, RtolOpt, SetOpt,
-                     TransitionOpt, WorkersOpt, check_outputs, echo_written, load_params,
+from .common import (AtolOpt, DaskOpt, ModelOpt, OutOpt, PlotOpt, PresetOpt, RtolOpt, SetOpt,
+                     TransitionOpt, WorkersOpt, check_outputs, chunk_store, echo_written, load_params,
                      preset_label, require_output, save_outputs)
 
 
@@ -57,6 +57,7 @@ def eta_study_cmd(
         help="section distance to the exact points counted as agreement (gap units)")] = 1e-3,
     transition: TransitionOpt = "eq13",
     workers: WorkersOpt = None,
+    dask: DaskOpt = None,
     out: OutOpt = None,
     plot: PlotOpt = None,
 ):
@@ -75,11 +76,13 @@ def eta_study_cmd(
     preset = preset_label(params, preset, "fig4")
     require_output(out, plot)
     check_outputs(out, plot)
+    store, engine = chunk_store(out, dask)
     with _progress("eta study") as prog:
         ds = eta_study(params, etas, transient=transient, record=record,
                        orbit_periods=orbit_periods, samples_per_period=samples_per_period,
                        x0=x0, v0=v0, rtol=rtol, atol=atol, distance_tol=distance_tol,
-                       transition=transition, workers=workers, progress=prog)
+                       transition=transition, workers=workers, progress=prog,
+                       store=store, engine=engine)
     m = params.model
     full = "Gamma+" if m.name == "support" else " or ".join(
         nm for i, nm in enumerate(m.mode_names) if m.contact_modes >> i & 1) or "contact"

@@ -37,6 +37,9 @@ _PLOTS = {
     "plot_lyapunov": ".stability",
     "plot_orbit": ".stability",
     "plot_continuation": ".continuation",
+    "plot_two_parameter": ".continuation",
+    "plot_parameter_map": ".parameter_map",
+    "plot_lambda1_map": ".parameter_map",
 }
 
 __all__ = ["MODE_COLORS", "MODE_LABELS", "LINE_LABELS", "REGION_COLORS", "REGION_LABELS",

@@ -103,6 +103,7 @@ groups); this module runs the rounds and builds the Dataset.
 
 from __future__ import annotations
 
+import functools
 import warnings
 
 import numba as nb
@@ -143,7 +144,8 @@ def basins(params: ParamsBase, *, x=(-3.0, 3.0), v=(-3.0, 3.0), grid=400, method
            transient: int = 10, max_periods: int = 1000, max_period: int = 16, rtol: float = 1e-8,
            atol: float = 1e-10, transition: str = "eq13", early_stop: bool = True,
            samples_per_period: int = 200, workers: int | None = None,
-           progress=None, lyapunov: bool | None = None) -> xr.Dataset:
+           progress=None, lyapunov: bool | None = None, store=None,
+           engine=None) -> xr.Dataset:
     """Basins of attraction of the stroboscopic map on a grid of initial conditions.
 
     ``x``, ``v``: (min, max) ranges of the initial X and V (forcing phase 0); ``grid``: points
@@ -171,8 +173,14 @@ def basins(params: ParamsBase, *, x=(-3.0, 3.0), v=(-3.0, 3.0), grid=400, method
     unit time, over ``LYAPUNOV_PERIODS`` periods from its first section point: tangent
     dynamics with saltation matrices, ``analysis.stability``); for a periodic attractor it is
     ln|mu_1| / T of its leading Floquet multiplier.
+
+    ``store`` / ``engine``: chunked, resumable runs and where they run (``nonsmooth.chunks``):
+    each round is a chunk, continued from the attractors the rounds before it found, so the
+    rounds run one after the other (on Dask: one worker at a time, with its threads).
     """
+    from ...chunks import Plan, check_engine, execute, plan_solver
     from ..stability import wants_lyapunov
+    engine = check_engine(engine)
     params = check_params(params)
     x_lo, x_hi = _check_range("x", x)
     v_lo, v_hi = _check_range("v", v)
@@ -190,39 +198,35 @@ def basins(params: ParamsBase, *, x=(-3.0, 3.0), v=(-3.0, 3.0), grid=400, method
 
     xs = np.linspace(x_lo, x_hi, nx)
     vs = np.linspace(v_lo, v_hi, nv)
-    order, first = _coarse_to_fine_order(nx, nv)
-    X0 = np.repeat(xs, nv)[order]
-    V0 = np.tile(vs, nx)[order]
     pk = params.pack()
     scale = max(abs(x_lo), abs(x_hi), abs(v_lo), abs(v_hi), 1.0)
     tol = section_tolerance(rtol, atol, scale)
-    found = _Attractors(tol)
-    clouds = _Clouds(x_lo, x_hi, v_lo, v_hi, n)
-    cert = {"periods": 0}
     certified = bool(early_stop) and MAP_IS_HOMEOMORPHISM and solver.spec.flow_is_homeomorphism
-    lat = _Lattice(x_lo, x_hi, v_lo, v_hi, nx, nv, first)
-    pace = _Pace(2 * first)
+    order, first = _order(nx, nv)
+    rounds = list(_round_sizes(n, first))
+    spec = {"solver": plan_solver(solver, engine), "pk": pk, "x": (x_lo, x_hi),
+            "v": (v_lo, v_hi), "nx": nx, "nv": nv, "transient": transient,
+            "max_periods": max_periods, "max_period": max_period, "tol": tol,
+            "certified": certified, "rounds": rounds}
+    plan = Plan("basins", {k: v for k, v in spec.items() if k != "rounds"} | {
+        "early_stop": bool(early_stop), "samples_per_period": spp,
+        "lyapunov": bool(wants_lyapunov(lyapunov, solver))}, len(rounds), _basins_round,
+        spec, chained=True, weights=[b - a for a, b in rounds])
     label = np.full(n, LABEL_UNDECIDED, np.int64)  # in processing order
-    used = np.zeros(n, np.int64)
+    used = np.zeros(n, np.int32)
     status = np.zeros(n, np.int64)
+    last = {}
+
+    def collect(i, res):
+        a, b = rounds[i]
+        label[a:b] = res["label"]
+        used[a:b] = res["used"]
+        status[a:b] = res["status"]
+        last["carry"] = res["carry"]
+    execute(plan, collect, store=store, engine=engine, workers=nw,
+            progress=None if progress is None else (lambda d, t: progress(d, n)))
+    found, clouds, lat, cert = (last["carry"][k] for k in ("found", "clouds", "lat", "cert"))
     with threads(nw):
-        old_chunk = nb.get_parallel_chunksize()
-        nb.set_parallel_chunksize(8)
-        try:
-            for a, b in _round_sizes(n, first):
-                rec = _run_round_points(solver, pk, X0[a:b], V0[a:b], a, n, max_periods,
-                                        transient, tol, max_period, certified, found, lat,
-                                        clouds, pace, progress)
-                label[a:b] = rec[:, _RES]
-                used[a:b] = rec[:, _K]
-                status[a:b] = rec[:, _STATUS]
-                if certified and not all(found.certified):
-                    _certify_all(found, solver, pk, cert)
-                    lat.stale = True
-                if certified and lat.stale and lat.active and b >= lat.start_after:
-                    lat.certify(found, solver, pk, cert)
-        finally:
-            nb.set_parallel_chunksize(old_chunk)
         for members, state in clouds.groups():
             chaos = _confirm_chaos(solver, pk, state, tol, max_period, scale)
             if chaos is not None:
@@ -235,8 +239,9 @@ def basins(params: ParamsBase, *, x=(-3.0, 3.0), v=(-3.0, 3.0), grid=400, method
     # back to grid order, canonical labels
     grid = {}
     for name, arr in (("label", label), ("used", used), ("status", status)):
-        grid[name] = np.empty(n, np.int64)
+        grid[name] = np.empty(n, arr.dtype)
         grid[name][order] = arr
+    del label, used, status
     n_att = len(found.points)
     kind = np.array(found.kind, dtype=np.int64)
     contact = np.array([int(params.model.is_contact(params, mk, mx, mn)) for mx, mn, mk in
@@ -264,6 +269,50 @@ def basins(params: ParamsBase, *, x=(-3.0, 3.0), v=(-3.0, 3.0), grid=400, method
                          match_tol=found.match_tol,
                          certification_periods=cert["periods"],
                          certified_cells=lat.n_certified(), lattice_cells=lat.size()))
+
+
+@functools.lru_cache(maxsize=2)
+def _order(nx: int, nv: int):
+    """The coarse-to-fine visiting order of an nx x nv grid (computed once per process)."""
+    return _coarse_to_fine_order(nx, nv)
+
+
+def _basins_round(spec, i, carry, workers=None, progress=None):
+    """Round ``i`` of :func:`basins` (a chained ``chunks.Plan`` task): the records of its
+    points and, as ``carry``, what later rounds depend on (the attractors found, their
+    certified discs, the lattice, the chaotic candidates)."""
+    from ...chunks import solver_from_spec
+    solver = solver_from_spec(spec["solver"])
+    (x_lo, x_hi), (v_lo, v_hi), nx, nv = spec["x"], spec["v"], spec["nx"], spec["nv"]
+    n = nx * nv
+    order, first = _order(nx, nv)
+    if carry is None:
+        carry = {"found": _Attractors(spec["tol"]), "clouds": _Clouds(x_lo, x_hi, v_lo, v_hi, n),
+                 "lat": _Lattice(x_lo, x_hi, v_lo, v_hi, nx, nv, first), "cert": {"periods": 0}}
+    found, clouds, lat, cert = (carry[k] for k in ("found", "clouds", "lat", "cert"))
+    a, b = spec["rounds"][i]
+    idx = order[a:b]
+    X0 = np.linspace(x_lo, x_hi, nx)[idx // nv]
+    V0 = np.linspace(v_lo, v_hi, nv)[idx % nv]
+    pk, certified = spec["pk"], spec["certified"]
+    with threads(workers):
+        old_chunk = nb.get_parallel_chunksize()
+        nb.set_parallel_chunksize(8)
+        try:
+            rec = _run_round_points(solver, pk, X0, V0, a, n, spec["max_periods"],
+                                    spec["transient"], spec["tol"], spec["max_period"],
+                                    certified, found, lat, clouds, _Pace(2 * first),
+                                    None if progress is None else
+                                    (lambda d, _t: progress(d - a, b - a)))
+            if certified and not all(found.certified):
+                _certify_all(found, solver, pk, cert)
+                lat.stale = True
+            if certified and lat.stale and lat.active and b >= lat.start_after:
+                lat.certify(found, solver, pk, cert)
+        finally:
+            nb.set_parallel_chunksize(old_chunk)
+    return {"label": rec[:, _RES], "used": rec[:, _K], "status": rec[:, _STATUS],
+            "carry": carry}
 
 
 def _run_round_points(solver, pk, X0, V0, done_before, n, max_periods, transient, tol,

@@ -1,0 +1,474 @@
+"""Chunked, resumable runs (importing this module is cheap: numpy is loaded on first use): a sweep is cut into chunks that are computed by an engine (the
+embedded one: numba threads on all local cores; or a Dask distributed cluster) and written, as
+each finishes, to a chunk store on disk; the final result is assembled from the chunks.
+
+* **Plan** (what to compute): ``task(spec, i, carry, workers=None, progress=None)`` computes
+  chunk ``i`` and returns a dict of numpy arrays (and, for a *chained* plan, a ``"carry"``
+  entry handed to chunk ``i + 1``: the state a continuation sweep goes on from). ``task`` is a
+  module-level function and ``spec`` plain data, so that both travel to Dask workers; a chunk
+  depends only on ``spec``, ``i`` and ``carry``, never on the engine, the number of threads or
+  of workers, so every engine gives the same bits.
+* **Store** (:class:`ChunkStore`): a directory with ``manifest.json`` (the analysis and the
+  fingerprint of its inputs, including the package version and the chunk layout) and one
+  ``.npz`` file (numpy's format) per finished chunk, each written to a temporary name and renamed, so that a
+  chunk file is complete or absent: a SIGKILL loses at most the chunks in flight. Opening a
+  store of a different run is refused with one line; running the same plan again computes
+  only the chunks that are missing, and the resumed result is bit-identical to an
+  uninterrupted one (the files keep every bit of the arrays).
+* **Engines** (:func:`execute`): ``engine=None`` or ``"embedded"``; ``"local"`` /
+  ``"local:N"`` (a Dask LocalCluster of N worker processes, one thread each, started and
+  stopped here); a scheduler address (``tcp://host:8786``); or a ``dask.distributed.Client``.
+  On Dask every chunk is a task (``retries`` if its worker dies); the client writes the chunk
+  files as results arrive, with at most a few chunks in flight per worker thread.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import dataclasses
+import json
+import math
+import os
+import pickle
+import shutil
+import threading
+import uuid
+from pathlib import Path
+from typing import Any, Callable
+
+from ._version import __version__
+from .errors import OutputError, ParameterError
+
+#: Seconds to wait for a Dask scheduler before giving up with one line.
+CONNECT_TIMEOUT = 5.0
+#: Chunks in flight per Dask worker thread (more hides latency, fewer bounds memory).
+IN_FLIGHT_PER_THREAD = 2
+#: Times a Dask task is retried when its worker dies or it fails.
+RETRIES = 3
+
+
+@dataclasses.dataclass
+class Plan:
+    """A chunked computation. ``fingerprint``: JSON-able inputs that determine the result
+    (a store of another fingerprint is refused); ``weights``: work per chunk (progress)."""
+
+    analysis: str
+    fingerprint: dict
+    n_chunks: int
+    task: Callable
+    spec: Any
+    chained: bool = False
+    weights: list | None = None
+
+    def manifest(self) -> dict:
+        return {"analysis": self.analysis, "nonsmooth_version": __version__,
+                "n_chunks": int(self.n_chunks), "chained": bool(self.chained),
+                "fingerprint": _jsonable(self.fingerprint)}
+
+
+def _jsonable(obj):
+    """Plain JSON types; floats as repr strings so that every bit counts in comparisons."""
+    import numpy as np
+    if isinstance(obj, dict):
+        return {str(k): _jsonable(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple, np.ndarray)):
+        return [_jsonable(v) for v in (obj.tolist() if isinstance(obj, np.ndarray) else obj)]
+    if isinstance(obj, (bool, np.bool_)):
+        return bool(obj)
+    if isinstance(obj, (int, np.integer)):
+        return int(obj)
+    if isinstance(obj, (float, np.floating)):
+        return repr(float(obj))
+    return None if obj is None else str(obj)
+
+
+# ---- the store ----------------------------------------------------------------------------------
+class ChunkStore:
+    """Finished chunks of one plan in a directory (see the module docstring)."""
+
+    def __init__(self, path, plan: Plan):
+        self.path = Path(path)
+        self.plan = plan
+        manifest = plan.manifest()
+        mfile = self.path / "manifest.json"
+        if self.path.exists() and not self.path.is_dir():
+            raise OutputError(f"store: {str(self.path)!r} exists and is not a chunk store")
+        if mfile.is_file():
+            try:
+                old = json.loads(mfile.read_text())
+            except (OSError, ValueError) as exc:
+                raise OutputError(f"store: cannot read {str(mfile)!r}: {exc}") from None
+            if old != manifest:
+                raise ParameterError(f"store: {str(self.path)!r} holds a different run "
+                                     f"({_difference(old, manifest)}); give another output "
+                                     f"file, or delete that directory to start afresh")
+        else:
+            if self.path.exists() and any(self.path.iterdir()):
+                raise OutputError(f"store: {str(self.path)!r} is not empty and has no "
+                                  f"manifest.json; not a chunk store of nonsmooth")
+            try:
+                self.path.mkdir(parents=False, exist_ok=True)
+                _atomic_write(mfile, json.dumps(manifest, indent=1, sort_keys=True).encode())
+            except OSError as exc:
+                raise OutputError(f"store: cannot write {str(self.path)!r}: "
+                                  f"{exc.strerror or exc}") from None
+        self.resumed = sorted(self.done())
+
+    def chunk_file(self, i: int) -> Path:
+        return self.path / f"chunk-{i:06d}.npz"
+
+    def done(self) -> set:
+        out = set()
+        for p in self.path.glob("chunk-*.npz"):
+            with contextlib.suppress(ValueError):
+                out.add(int(p.stem.split("-")[1]))
+        return {i for i in out if 0 <= i < self.plan.n_chunks}
+
+    def write(self, i: int, result: dict) -> None:
+        data = _to_bytes(result)
+        try:
+            _atomic_write(self.chunk_file(i), data)
+        except OSError as exc:
+            raise OutputError(f"store: cannot write chunk {i} to {str(self.path)!r}: "
+                              f"{exc.strerror or exc}") from None
+
+    def read(self, i: int) -> dict:
+        try:
+            return _from_bytes(self.chunk_file(i).read_bytes())
+        except (OSError, ValueError, KeyError) as exc:
+            raise OutputError(f"store: chunk file {str(self.chunk_file(i))!r} is unreadable "
+                              f"({exc}); delete it to recompute that chunk") from None
+
+    def remove(self) -> None:
+        shutil.rmtree(self.path, ignore_errors=True)
+
+
+def _difference(old: dict, new: dict) -> str:
+    if old.get("analysis") != new.get("analysis"):
+        return f"analysis {old.get('analysis')!r}, this run {new.get('analysis')!r}"
+    if old.get("nonsmooth_version") != new.get("nonsmooth_version"):
+        return f"written by nonsmooth {old.get('nonsmooth_version')}, this is {__version__}"
+    a, b = old.get("fingerprint", {}), new.get("fingerprint", {})
+    keys = sorted(k for k in set(a) | set(b) if a.get(k) != b.get(k))
+    if keys:
+        shown = ", ".join(f"{k}: stored {_show(a.get(k))}, now {_show(b.get(k))}"
+                          for k in keys[:3])
+        return shown + (f" and {len(keys) - 3} more" if len(keys) > 3 else "")
+    return "different chunk layout"
+
+
+def _show(v) -> str:
+    """A fingerprint value for a message (long lists shortened)."""
+    if isinstance(v, list):
+        if len(v) > 4:
+            return f"[{_show(v[0])}, {_show(v[1])}, ..., {_show(v[-1])}] ({len(v)} values)"
+        return "[" + ", ".join(_show(x) for x in v) + "]"
+    if isinstance(v, dict):
+        return "{...}"
+    return str(v)
+
+
+def _atomic_write(path: Path, data: bytes) -> None:
+    tmp = path.with_name(f".{path.name}.{uuid.uuid4().hex[:8]}.part")
+    try:
+        with open(tmp, "wb") as f:
+            f.write(data)
+            f.flush()
+            os.fsync(f.fileno())
+        os.replace(tmp, path)
+    except BaseException:
+        with contextlib.suppress(OSError):
+            tmp.unlink()
+        raise
+
+
+def _to_bytes(result: dict) -> bytes:
+    """A chunk result as numpy's ``.npz`` (arrays as they are; other values, e.g. a carried
+    Python state, pickled into a uint8 array). About 100 times faster to write than a netCDF
+    file per chunk; the final result is one netCDF file."""
+    import io
+    import numpy as np
+    data = {}
+    for name, value in result.items():
+        if isinstance(value, np.ndarray) and value.dtype != object:
+            data[f"a_{name}"] = value
+        else:
+            data[f"p_{name}"] = np.frombuffer(pickle.dumps(value, protocol=5), np.uint8)
+    buf = io.BytesIO()
+    np.savez(buf, **data)
+    return buf.getvalue()
+
+
+def _from_bytes(blob: bytes) -> dict:
+    import io
+    import numpy as np
+    out = {}
+    with np.load(io.BytesIO(blob), allow_pickle=False) as z:
+        for name in z.files:
+            arr = z[name]
+            out[name[2:]] = arr if name.startswith("a_") else pickle.loads(arr.tobytes())
+    return out
+
+
+# ---- engines -------------------------------------------------------------------------------------
+_ENGINE_HINT = "embedded, local, local:N, a scheduler address (tcp://host:8786) or a Client"
+
+
+def check_engine(engine):
+    """Validate ``engine`` without starting anything: None, "embedded", "local[:N]", an
+    address, or a dask.distributed.Client. Returns it normalised (None for embedded)."""
+    if engine is None or engine == "embedded":
+        return None
+    if isinstance(engine, str):
+        e = engine.strip()
+        if e == "local" or e.startswith("local:"):
+            n = e.partition(":")[2]
+            if n and (not n.isdigit() or int(n) < 1):
+                raise ParameterError(f"dask: local:N needs N >= 1 workers, got {engine!r}")
+            return e
+        if not e or any(c.isspace() for c in e):
+            raise ParameterError(f"dask: expected {_ENGINE_HINT}, got {engine!r}")
+        return e
+    if type(engine).__name__ == "Client" and hasattr(engine, "submit"):
+        return engine
+    raise ParameterError(f"engine: expected {_ENGINE_HINT}, got {engine!r}")
+
+
+@contextlib.contextmanager
+def dask_client(engine):
+    """A connected ``Client`` for a normalised Dask ``engine`` (closed on exit where opened
+    here); one line when Dask is missing or the scheduler cannot be reached."""
+    if not isinstance(engine, str):
+        yield engine
+        return
+    try:
+        import distributed
+    except ImportError:
+        raise ParameterError('dask: Dask is not installed; pip install "nonsmooth[dask]"') from None
+    import logging
+    for name in ("distributed", "tornado"):  # connection noise would hide our one line
+        logging.getLogger(name).setLevel(logging.CRITICAL)
+    if engine.startswith("local"):
+        n = int(engine.partition(":")[2] or (os.cpu_count() or 1))
+        import warnings
+        with warnings.catch_warnings():  # "port 8787 in use" and the like
+            warnings.simplefilter("ignore")
+            cluster = distributed.LocalCluster(n_workers=n, threads_per_worker=1,
+                                               processes=True, dashboard_address=None,
+                                               silence_logs=logging.CRITICAL)
+        client = distributed.Client(cluster)
+        try:
+            yield client
+        finally:
+            with contextlib.suppress(Exception):
+                client.close()
+                cluster.close()
+        return
+    address = engine if "://" in engine else f"tcp://{engine}"
+    try:
+        client = distributed.Client(address, timeout=CONNECT_TIMEOUT)
+    except (OSError, TimeoutError, ValueError) as exc:
+        reason = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+        raise ParameterError(f"dask: cannot reach the scheduler at {address} within "
+                             f"{CONNECT_TIMEOUT:g} s ({reason[:120]})") from None
+    try:
+        yield client
+    finally:
+        with contextlib.suppress(Exception):
+            client.close()
+
+
+_kernel_lock = threading.Lock()
+
+
+def _dask_task(task, spec, i, carry):
+    """Run one chunk on a Dask worker: one chunk at a time per worker process (numba's
+    default threading layer must not be entered by two threads at once), with as many numba
+    threads as the worker has threads."""
+    import numba as nb
+    try:
+        from distributed import get_worker
+        n = int(get_worker().state.nthreads)
+    except Exception:  # not on a worker (a synchronous test client)
+        n = 1
+    n = max(1, min(n, nb.config.NUMBA_NUM_THREADS))
+    with _kernel_lock:
+        return task(spec, i, carry, workers=n)
+
+
+# ---- running a plan ------------------------------------------------------------------------------
+#: Called as ``on_resume(path, chunks_done, chunks_total)`` when a run finds finished chunks in
+#: its store (the CLI prints one line); None: silent.
+on_resume = None
+
+#: Stores of the runs of this process that were interrupted (the CLI's message says what they
+#: hold and how to resume): (path, chunks finished, chunks in all).
+interrupted_stores: list = []
+
+
+def execute(plan: Plan, collect: Callable[[int, dict], None], *, store=None, engine=None,
+            workers=None, progress=None) -> None:
+    """Compute every chunk of ``plan`` and hand each result to ``collect(i, result)``, in
+    chunk order for a chained plan and in order of completion otherwise (``collect`` must put
+    each chunk in its place). With ``store`` (a directory, see :class:`ChunkStore`) the
+    finished chunks are written there and the chunks already there are read instead of
+    computed. ``progress(done, total)`` counts ``plan.weights``."""
+    engine = check_engine(engine)
+    st = ChunkStore(store, plan) if store is not None else None
+    done = st.done() if st is not None else set()
+    if done and on_resume is not None:
+        on_resume(st.path, len(done), plan.n_chunks)
+    weights = [float(w) for w in (plan.weights or [1.0] * plan.n_chunks)]
+    total = sum(weights) or 1.0
+    finished = [0.0]
+
+    def report(extra=0.0):
+        if progress is not None:
+            progress(int(round(finished[0] + extra)), int(round(total)))
+
+    def finish(i, res, write=True):
+        if write and st is not None:
+            st.write(i, res)
+        collect(i, res)
+        finished[0] += weights[i]
+        report()
+
+    try:
+        carry = None
+        todo = []
+        for i in range(plan.n_chunks):
+            if i in done and (not plan.chained or not todo):
+                res = st.read(i)
+                carry = res.get("carry")
+                finish(i, res, write=False)
+            else:
+                todo.append(i)
+        if engine is None:
+            for i in todo:
+                w = weights[i]
+
+                def inner(d, t, _w=w):
+                    report(_w * d / t if t else 0.0)
+                res = plan.task(plan.spec, i, carry, workers=workers,
+                                progress=inner if progress is not None else None)
+                carry = res.get("carry")
+                finish(i, res)
+        else:
+            with dask_client(engine) as client:
+                _run_dask(client, plan, todo, carry, finish)
+    except BaseException:
+        if st is not None:
+            interrupted_stores.append((st.path, len(st.done()), plan.n_chunks))
+        raise
+
+
+def _run_dask(client, plan, todo, carry, finish):
+    from distributed import as_completed
+    if not todo:
+        return
+    if plan.chained:
+        for i in todo:
+            fut = client.submit(_dask_task, plan.task, plan.spec, i, carry, pure=False,
+                                retries=RETRIES, key=f"nonsmooth-{plan.analysis}-{i}-{uuid.uuid4().hex[:6]}")
+            res = fut.result()
+            carry = res.get("carry")
+            finish(i, res)
+            del fut
+        return
+    nthreads = sum(client.nthreads().values()) or 1
+    window = max(2, IN_FLIGHT_PER_THREAD * nthreads)
+    spec = client.scatter(plan.spec, broadcast=True) if _big(plan.spec) else plan.spec
+    queue = list(todo)
+    index = {}
+
+    def submit(i):
+        fut = client.submit(_dask_task, plan.task, spec, i, None, pure=False, retries=RETRIES,
+                            key=f"nonsmooth-{plan.analysis}-{i}-{uuid.uuid4().hex[:6]}")
+        index[fut.key] = i
+        return fut
+
+    ac = as_completed([submit(queue.pop(0)) for _ in range(min(window, len(queue)))])
+    for fut in ac:
+        res = fut.result()
+        i = index.pop(fut.key)
+        fut.release()
+        if queue:
+            ac.add(submit(queue.pop(0)))
+        finish(i, res)
+
+
+def _big(spec) -> bool:
+    with contextlib.suppress(Exception):
+        return len(pickle.dumps(spec)) > 1_000_000
+    return False
+
+
+def chunk_bounds(n: int, size: int) -> list:
+    """[(start, stop), ...] of ``n`` items in chunks of ``size`` (the last may be shorter)."""
+    size = max(1, int(size))
+    return [(a, min(n, a + size)) for a in range(0, n, size)] or [(0, 0)]
+
+
+def store_for(out) -> Path | None:
+    """The chunk store of a run whose result goes to ``out``: ``<out>.chunks`` next to it."""
+    return None if out is None else Path(str(out) + ".chunks")
+
+
+def remove_store(path) -> None:
+    """Delete a chunk store (a directory with a ``manifest.json``; anything else is left)."""
+    if path is not None and (Path(path) / "manifest.json").is_file():
+        shutil.rmtree(path, ignore_errors=True)
+
+
+def solver_spec(solver) -> dict:
+    """A Solver as plain data that Dask workers can rebuild (:func:`solver_from_spec`); a
+    model defined only in this process (not built in, not loaded from a file) cannot travel."""
+    m = solver.model
+    ref = m.name if m.source == "built-in" else m.source
+    return {"model": ref, "method": solver.method, "rtol": solver.rtol, "atol": solver.atol,
+            "transition": solver.transition, "max_steps": solver.max_steps,
+            "defined_in_process": m.source == "built-in" and _not_builtin(m)}
+
+
+def _not_builtin(m) -> bool:
+    from .models import BUILTIN
+    return m.name not in BUILTIN
+
+
+_models_here: dict = {}
+
+
+def remember_model(model) -> None:
+    """Models defined in this process, so that embedded tasks can find them by name."""
+    _models_here[model.name] = model
+
+
+def solver_from_spec(spec: dict):
+    from .kernels import Solver
+    from .models import model as get_model
+    if spec.get("defined_in_process"):
+        m = _models_here.get(spec["model"])
+        if m is None:
+            raise ParameterError(f"model: {spec['model']!r} is defined in the client process "
+                                 f"only; Dask workers need it in a file (path/to/file.py:NAME)")
+    else:
+        m = get_model(spec["model"])
+    return Solver(model=m, method=spec["method"], rtol=spec["rtol"], atol=spec["atol"],
+                  transition=spec["transition"], max_steps=spec["max_steps"])
+
+
+def plan_solver(solver, engine) -> dict:
+    """``solver_spec`` for a plan run on ``engine``; refuses, before anything starts, a model
+    that Dask workers could not rebuild."""
+    spec = solver_spec(solver)
+    if spec["defined_in_process"]:
+        if check_engine(engine) is not None:
+            raise ParameterError(f"engine: model {solver.model.name!r} is defined in this "
+                                 f"process only; for Dask put it in a file and use "
+                                 f"path/to/file.py:NAME")
+        remember_model(solver.model)
+    return spec
+
+
+def n_chunks_for(n: int, target: int) -> int:
+    return max(1, math.ceil(n / max(1, target)))
