@@ -1,4 +1,4 @@
-"""Issue 8 item 7: result files of simulate, poincare, bifurcation, resonance and eta_study
+"""Issue 8 item 7: result files of simulate, poincare, bifurcation, resonance, eta_study and maps
 follow CF (checked with cf_xarray and pint's UDUNITS parsing) and one naming scheme."""
 
 import numpy as np
@@ -22,6 +22,8 @@ def _datasets():
         "resonance": resonance_curve(ns.preset("fig6a"), [0.9, 1.0], transient=10, record=4),
         "eta_study": eta_study(ns.preset("fig6a"), [0.1, 0.01], transient=10, record=6,
                                orbit_periods=1, samples_per_period=8),
+        "parameter_map": ns.parameter_map(p3, x=("omega", 0.9, 0.92, 3),
+                                          y=("F0", 0.3, 0.31, 2), transient=20, record=6),
     }
 
 

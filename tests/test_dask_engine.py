@@ -80,4 +80,14 @@ def test_an_unreachable_scheduler_is_one_line_within_seconds(capsys, tmp_path):
                             "-o", str(out)], capsys)
     assert code == 2 and time.monotonic() - t0 < 15
     one_line(err, "dask: cannot reach the scheduler at tcp://127.0.0.1:1")
-    assert not out.exists()
+    assert not out.exists() and not (tmp_path / "m.nc.chunks").exists()
+
+
+def test_cli_dask_local_gives_the_embedded_file(capsys, tmp_path):
+    args = ["map", "--method", "exact", "--x", "omega", "0.88", "0.92", "5", "--y", "F0", "0.28",
+            "0.3", "3", "--transient", "100", "--record", "30"]
+    code, _, err = run_cli(args + ["--dask", "local:2", "-o", str(tmp_path / "d.nc")], capsys)
+    assert code == 0, err
+    code, _, err = run_cli(args + ["-o", str(tmp_path / "e.nc")], capsys)
+    assert code == 0, err
+    _equal(ns.io.load_dataset(tmp_path / "d.nc"), ns.io.load_dataset(tmp_path / "e.nc"))

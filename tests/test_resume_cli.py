@@ -112,3 +112,27 @@ def test_sigkill_loses_only_chunks_in_flight_and_a_store_of_another_run_is_refus
     assert res.returncode == 0, res.stderr
     assert "resuming from" in res.stderr
     _same(out, reference)
+
+
+def test_a_killed_continuation_sweep_resumes_from_its_last_chunk(tmp_path):
+    """Chained chunks (up and down sweeps continue from the chunk before): a SIGKILL, then the
+    same command resumes from the states stored with the last finished chunk."""
+    args = ["bifurcation", "--preset", "table3", "--from", "0.8", "--to", "1.0", "--steps",
+            "400", "--transient", "300", "--record", "50", "--method", "smooth"]
+    ref = ns.bifurcation_diagram(ns.preset("table3"), "omega", np.linspace(0.8, 1.0, 400),
+                                 transient=300, record=50, method="smooth")
+    out = tmp_path / "b.nc"
+    store = tmp_path / "b.nc.chunks"
+    proc = subprocess.Popen([sys.executable, "-m", "nonsmooth.cli", *args, "-o", str(out)],
+                            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, cwd=tmp_path)
+    _wait_for_chunks(proc, store, 2)
+    assert proc.poll() is None
+    proc.kill()
+    proc.wait(timeout=30)
+    n_saved = len(list(store.glob("chunk-*.npz")))
+    assert 2 <= n_saved < 16
+    res = subprocess.run([sys.executable, "-m", "nonsmooth.cli", *args, "-o", str(out)],
+                         capture_output=True, text=True, cwd=tmp_path, timeout=300)
+    assert res.returncode == 0, res.stderr
+    assert f"of 16 chunks already done" in res.stderr
+    _same(out, ref)

@@ -27,7 +27,6 @@ from __future__ import annotations
 import contextlib
 import dataclasses
 import json
-import math
 import os
 import pickle
 import shutil
@@ -37,13 +36,15 @@ from pathlib import Path
 from typing import Any, Callable
 
 from ._version import __version__
-from .errors import OutputError, ParameterError
+from .errors import NonsmoothError, OutputError, ParameterError
 
 #: Seconds to wait for a Dask scheduler before giving up with one line.
 CONNECT_TIMEOUT = 5.0
 #: Chunks in flight per Dask worker thread (more hides latency, fewer bounds memory).
 IN_FLIGHT_PER_THREAD = 2
-#: Times a Dask task is retried when its worker dies or it fails.
+#: Times a Dask task that raised is retried. A task whose worker dies is rescheduled by the
+#: scheduler itself (up to its ``distributed.scheduler.allowed-failures``, 3 by default);
+#: beyond that the run stops with one line saying which chunks are saved.
 RETRIES = 3
 
 
@@ -78,13 +79,16 @@ def _jsonable(obj):
     if isinstance(obj, (int, np.integer)):
         return int(obj)
     if isinstance(obj, (float, np.floating)):
-        return repr(float(obj))
+        return repr(float(obj) + 0.0)  # -0.0 and 0.0 are the same input
     return None if obj is None else str(obj)
 
 
 # ---- the store ----------------------------------------------------------------------------------
 class ChunkStore:
-    """Finished chunks of one plan in a directory (see the module docstring)."""
+    """Finished chunks of one plan in a directory (see the module docstring); a chained plan's
+    chunk file also holds its ``carry`` (the state the next chunk goes on from; kept small:
+    basins, e.g., carries its attractors, not its per-point data). The store is locked while a
+    run uses it: a second run with the same store is refused."""
 
     def __init__(self, path, plan: Plan):
         self.path = Path(path)
@@ -93,31 +97,51 @@ class ChunkStore:
         mfile = self.path / "manifest.json"
         if self.path.exists() and not self.path.is_dir():
             raise OutputError(f"store: {str(self.path)!r} exists and is not a chunk store")
+        old = None
         if mfile.is_file():
             try:
                 old = json.loads(mfile.read_text())
             except (OSError, ValueError) as exc:
                 raise OutputError(f"store: cannot read {str(mfile)!r}: {exc}") from None
-            if old != manifest:
+        elif self.path.exists() and any(not p.name.startswith(".") and p.name != "lock"
+                                        for p in self.path.iterdir()):
+            raise OutputError(f"store: {str(self.path)!r} is not empty and has no "
+                              f"manifest.json; not a chunk store of nonsmooth")
+        try:
+            self.path.mkdir(parents=False, exist_ok=True)
+            self._lock = open(self.path / "lock", "w")
+        except OSError as exc:
+            raise OutputError(f"store: cannot write {str(self.path)!r}: "
+                              f"{exc.strerror or exc}") from None
+        try:
+            import fcntl
+            fcntl.flock(self._lock, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except ImportError:  # not on POSIX: no lock
+            pass
+        except OSError:
+            self._lock.close()
+            raise ParameterError(f"store: {str(self.path)!r} is in use by another run "
+                                 f"(the same output file); wait for it or use another -o")
+        if old is not None and old != manifest:
+            if self.done():
+                self._lock.close()
                 raise ParameterError(f"store: {str(self.path)!r} holds a different run "
-                                     f"({_difference(old, manifest)}); give another output "
-                                     f"file, or delete that directory to start afresh")
-        else:
-            if self.path.exists() and any(self.path.iterdir()):
-                raise OutputError(f"store: {str(self.path)!r} is not empty and has no "
-                                  f"manifest.json; not a chunk store of nonsmooth")
+                                     f"({_difference(old, manifest)}); use another output "
+                                     f"file or store, or delete that directory to start "
+                                     f"afresh")
+            old = None  # nothing finished there: nothing to lose
+        if old is None:
             try:
-                self.path.mkdir(parents=False, exist_ok=True)
                 _atomic_write(mfile, json.dumps(manifest, indent=1, sort_keys=True).encode())
             except OSError as exc:
                 raise OutputError(f"store: cannot write {str(self.path)!r}: "
                                   f"{exc.strerror or exc}") from None
-        self.resumed = sorted(self.done())
 
     def chunk_file(self, i: int) -> Path:
         return self.path / f"chunk-{i:06d}.npz"
 
     def done(self) -> set:
+        """Indices of the finished chunks."""
         out = set()
         for p in self.path.glob("chunk-*.npz"):
             with contextlib.suppress(ValueError):
@@ -125,9 +149,8 @@ class ChunkStore:
         return {i for i in out if 0 <= i < self.plan.n_chunks}
 
     def write(self, i: int, result: dict) -> None:
-        data = _to_bytes(result)
         try:
-            _atomic_write(self.chunk_file(i), data)
+            _atomic_write(self.chunk_file(i), _to_bytes(result))
         except OSError as exc:
             raise OutputError(f"store: cannot write chunk {i} to {str(self.path)!r}: "
                               f"{exc.strerror or exc}") from None
@@ -135,12 +158,14 @@ class ChunkStore:
     def read(self, i: int) -> dict:
         try:
             return _from_bytes(self.chunk_file(i).read_bytes())
-        except (OSError, ValueError, KeyError) as exc:
+        except Exception as exc:  # truncated or foreign file
             raise OutputError(f"store: chunk file {str(self.chunk_file(i))!r} is unreadable "
-                              f"({exc}); delete it to recompute that chunk") from None
+                              f"({type(exc).__name__}); delete it to recompute that "
+                              f"chunk") from None
 
-    def remove(self) -> None:
-        shutil.rmtree(self.path, ignore_errors=True)
+    def close(self) -> None:
+        with contextlib.suppress(Exception):
+            self._lock.close()
 
 
 def _difference(old: dict, new: dict) -> str:
@@ -148,24 +173,37 @@ def _difference(old: dict, new: dict) -> str:
         return f"analysis {old.get('analysis')!r}, this run {new.get('analysis')!r}"
     if old.get("nonsmooth_version") != new.get("nonsmooth_version"):
         return f"written by nonsmooth {old.get('nonsmooth_version')}, this is {__version__}"
-    a, b = old.get("fingerprint", {}), new.get("fingerprint", {})
-    keys = sorted(k for k in set(a) | set(b) if a.get(k) != b.get(k))
+    a, b = _flat(old.get("fingerprint", {})), _flat(new.get("fingerprint", {}))
+    keys = [k for k in list(a) + [k for k in b if k not in a] if a.get(k) != b.get(k)]
     if keys:
         shown = ", ".join(f"{k}: stored {_show(a.get(k))}, now {_show(b.get(k))}"
                           for k in keys[:3])
         return shown + (f" and {len(keys) - 3} more" if len(keys) > 3 else "")
-    return "different chunk layout"
+    return f"chunks: stored {old.get('n_chunks')}, now {new.get('n_chunks')}"
+
+
+def _flat(obj, prefix: str = "") -> dict:
+    """A fingerprint as {dotted.key[index]: leaf}: a message can name the value that differs
+    (lists of different lengths are one leaf: their lengths differ)."""
+    out = {}
+    if isinstance(obj, dict):
+        for k, v in obj.items():
+            out.update(_flat(v, f"{prefix}.{k}" if prefix else str(k)))
+    elif isinstance(obj, list) and obj and all(not isinstance(v, (list, dict)) for v in obj):
+        out[f"{prefix}#"] = f"{len(obj)} values"
+        for i, v in enumerate(obj):
+            out[f"{prefix}[{i}]"] = v
+    elif isinstance(obj, list):
+        for i, v in enumerate(obj):
+            out.update(_flat(v, f"{prefix}[{i}]"))
+        out[f"{prefix}#"] = f"{len(obj)} values"
+    else:
+        out[prefix] = obj
+    return out
 
 
 def _show(v) -> str:
-    """A fingerprint value for a message (long lists shortened)."""
-    if isinstance(v, list):
-        if len(v) > 4:
-            return f"[{_show(v[0])}, {_show(v[1])}, ..., {_show(v[-1])}] ({len(v)} values)"
-        return "[" + ", ".join(_show(x) for x in v) + "]"
-    if isinstance(v, dict):
-        return "{...}"
-    return str(v)
+    return "(none)" if v is None else str(v).strip("'")
 
 
 def _atomic_write(path: Path, data: bytes) -> None:
@@ -267,7 +305,11 @@ def dask_client(engine):
     address = engine if "://" in engine else f"tcp://{engine}"
     try:
         client = distributed.Client(address, timeout=CONNECT_TIMEOUT)
-    except (OSError, TimeoutError, ValueError) as exc:
+    except ValueError as exc:
+        raise ParameterError(f"dask: invalid scheduler address {engine!r} "
+                             f"({str(exc).splitlines()[0][:120] if str(exc) else 'ValueError'})"
+                             ) from None
+    except (OSError, TimeoutError) as exc:
         reason = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
         raise ParameterError(f"dask: cannot reach the scheduler at {address} within "
                              f"{CONNECT_TIMEOUT:g} s ({reason[:120]})") from None
@@ -301,9 +343,14 @@ def _dask_task(task, spec, i, carry):
 #: its store (the CLI prints one line); None: silent.
 on_resume = None
 
-#: Stores of the runs of this process that were interrupted (the CLI's message says what they
-#: hold and how to resume): (path, chunks finished, chunks in all).
-interrupted_stores: list = []
+#: Stores used by the runs of this process: (path, chunks in all). The CLI's message for an
+#: interrupted run says what they hold and how to resume.
+active_stores: list = []
+
+
+def saved_chunks(path) -> int:
+    """Finished chunk files in a store directory (0 when it is gone)."""
+    return len(list(Path(path).glob("chunk-*.npz"))) if Path(path).is_dir() else 0
 
 
 def execute(plan: Plan, collect: Callable[[int, dict], None], *, store=None, engine=None,
@@ -312,10 +359,23 @@ def execute(plan: Plan, collect: Callable[[int, dict], None], *, store=None, eng
     chunk order for a chained plan and in order of completion otherwise (``collect`` must put
     each chunk in its place). With ``store`` (a directory, see :class:`ChunkStore`) the
     finished chunks are written there and the chunks already there are read instead of
-    computed. ``progress(done, total)`` counts ``plan.weights``."""
+    computed. ``progress(done, total)`` counts ``plan.weights``. A Dask engine is connected
+    before the store is opened, so an unreachable scheduler leaves nothing behind."""
     engine = check_engine(engine)
-    st = ChunkStore(store, plan) if store is not None else None
+    with contextlib.ExitStack() as stack:
+        client = stack.enter_context(dask_client(engine)) if engine is not None else None
+        st = ChunkStore(store, plan) if store is not None else None
+        if st is not None:
+            stack.callback(st.close)
+            active_stores.append((st.path, plan.n_chunks))
+        _execute(plan, collect, st, client, workers, progress)
+
+
+def _execute(plan, collect, st, client, workers, progress):
     done = st.done() if st is not None else set()
+    if plan.chained:  # only the prefix of finished chunks counts
+        done = set(range(next((i for i in range(plan.n_chunks) if i not in done),
+                              plan.n_chunks)))
     if done and on_resume is not None:
         on_resume(st.path, len(done), plan.n_chunks)
     weights = [float(w) for w in (plan.weights or [1.0] * plan.n_chunks)]
@@ -333,68 +393,86 @@ def execute(plan: Plan, collect: Callable[[int, dict], None], *, store=None, eng
         finished[0] += weights[i]
         report()
 
-    try:
-        carry = None
-        todo = []
-        for i in range(plan.n_chunks):
-            if i in done and (not plan.chained or not todo):
-                res = st.read(i)
-                carry = res.get("carry")
-                finish(i, res, write=False)
-            else:
-                todo.append(i)
-        if engine is None:
-            for i in todo:
-                w = weights[i]
-
-                def inner(d, t, _w=w):
-                    report(_w * d / t if t else 0.0)
-                res = plan.task(plan.spec, i, carry, workers=workers,
-                                progress=inner if progress is not None else None)
-                carry = res.get("carry")
-                finish(i, res)
+    carry = None
+    todo = []
+    for i in range(plan.n_chunks):
+        if i in done and (not plan.chained or not todo):  # chained: the finished prefix
+            res = st.read(i)
+            carry = res.get("carry")
+            finish(i, res, write=False)
         else:
-            with dask_client(engine) as client:
-                _run_dask(client, plan, todo, carry, finish)
-    except BaseException:
-        if st is not None:
-            interrupted_stores.append((st.path, len(st.done()), plan.n_chunks))
+            todo.append(i)
+    if client is None:
+        for i in todo:
+            w = weights[i]
+
+            def inner(d, t, _w=w):
+                report(_w * d / t if t else 0.0)
+            res = plan.task(plan.spec, i, carry, workers=workers,
+                            progress=inner if progress is not None else None)
+            carry = res.get("carry")
+            finish(i, res)
+        return
+    try:
+        _run_dask(client, plan, todo, carry, finish)
+    except (KeyboardInterrupt, NonsmoothError):
         raise
+    except Exception as exc:  # a killed worker beyond the scheduler's allowed failures, a
+        # lost connection, a cancelled task: one line, and what is saved
+        saved = (f"; {saved_chunks(st.path)} of {plan.n_chunks} chunks saved in {st.path}, "
+                 f"run again to resume") if st is not None else ""
+        reason = str(exc).splitlines()[0][:160] if str(exc) else ""
+        raise NonsmoothError(f"dask: the cluster failed ({type(exc).__name__}: {reason})"
+                             f"{saved}") from None
+
+
+def _submit(client, plan, spec, i, carry):
+    return client.submit(_dask_task, plan.task, spec, i, carry, pure=False, retries=RETRIES,
+                         key=f"nonsmooth-{plan.analysis}-{i}-{uuid.uuid4().hex[:8]}")
 
 
 def _run_dask(client, plan, todo, carry, finish):
     from distributed import as_completed
     if not todo:
         return
-    if plan.chained:
-        for i in todo:
-            fut = client.submit(_dask_task, plan.task, plan.spec, i, carry, pure=False,
-                                retries=RETRIES, key=f"nonsmooth-{plan.analysis}-{i}-{uuid.uuid4().hex[:6]}")
+    futures = []
+    try:
+        if plan.chained:
+            for i in todo:
+                fut = _submit(client, plan, plan.spec, i, carry)
+                futures = [fut]
+                res = fut.result()
+                carry = res.get("carry")
+                finish(i, res)
+                fut.release()
+            return
+        nthreads = sum(client.nthreads().values()) or 1
+        window = max(2, IN_FLIGHT_PER_THREAD * nthreads)
+        spec = plan.spec
+        if _big(spec):  # one copy per worker, not one per task (a list: scattered whole)
+            [spec] = client.scatter([plan.spec], broadcast=True, hash=False)
+        queue = list(todo)
+        index = {}
+
+        def submit(i):
+            fut = _submit(client, plan, spec, i, None)
+            index[fut.key] = i
+            futures.append(fut)
+            return fut
+
+        ac = as_completed([submit(queue.pop(0)) for _ in range(min(window, len(queue)))])
+        for fut in ac:
             res = fut.result()
-            carry = res.get("carry")
+            i = index.pop(fut.key)
+            fut.release()
+            futures.remove(fut)
+            if queue:
+                ac.add(submit(queue.pop(0)))
             finish(i, res)
-            del fut
-        return
-    nthreads = sum(client.nthreads().values()) or 1
-    window = max(2, IN_FLIGHT_PER_THREAD * nthreads)
-    spec = client.scatter(plan.spec, broadcast=True) if _big(plan.spec) else plan.spec
-    queue = list(todo)
-    index = {}
-
-    def submit(i):
-        fut = client.submit(_dask_task, plan.task, spec, i, None, pure=False, retries=RETRIES,
-                            key=f"nonsmooth-{plan.analysis}-{i}-{uuid.uuid4().hex[:6]}")
-        index[fut.key] = i
-        return fut
-
-    ac = as_completed([submit(queue.pop(0)) for _ in range(min(window, len(queue)))])
-    for fut in ac:
-        res = fut.result()
-        i = index.pop(fut.key)
-        fut.release()
-        if queue:
-            ac.add(submit(queue.pop(0)))
-        finish(i, res)
+    finally:  # an interruption or a failure: nothing of this run stays on the cluster
+        if futures:
+            with contextlib.suppress(Exception):
+                client.cancel(futures)
 
 
 def _big(spec) -> bool:
@@ -468,7 +546,3 @@ def plan_solver(solver, engine) -> dict:
                                  f"path/to/file.py:NAME")
         remember_model(solver.model)
     return spec
-
-
-def n_chunks_for(n: int, target: int) -> int:
-    return max(1, math.ceil(n / max(1, target)))

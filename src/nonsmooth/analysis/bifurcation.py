@@ -199,13 +199,16 @@ FRESH_CHUNK = 100
 def run_branches(params: ParamsBase, param: str, values, solver: Solver, *, directions,
                  transient: int, record: int, x0: float, v0: float, settle: bool,
                  workers=None, progress=None, lyapunov: bool = False, store=None, engine=None,
-                 analysis: str = "bifurcation", fingerprint: dict | None = None):
+                 analysis: str = "bifurcation", fingerprint: dict | None = None,
+                 first_window: bool = False):
     """Run continuation branches over sorted ``values``; ``directions`` lists "up", "down"
     or "fresh". Returns dict of arrays (branch, value, n) in ascending value order, plus
     ``status`` and ``used`` (branch, value), ``S`` the kernel state after each value
     (branch, value, 5), the classification of :func:`summarize` (``period``, ``max_X``,
     ``min_X``, ``contact``), with ``lyapunov`` ``lambda1``, ``lambda1_stderr`` and ``motion``,
-    and the final ``state`` per branch.
+    and the final ``state`` per branch. With ``first_window``, also ``first_max_X``,
+    ``first_S`` and ``first_status``: max X, state and status of the first recorded window,
+    before sections still converging were extended (what the resonance refinement starts from).
 
     The values are computed in chunks (:data:`BRANCH_CHUNK` values of every direction, each
     chunk continued from the states the previous one ended with; a fresh sweep in independent
@@ -224,12 +227,13 @@ def run_branches(params: ParamsBase, param: str, values, solver: Solver, *, dire
     spec = {"solver": plan_solver(solver, engine), "rows": rows, "orders": orders,
             "fresh": fresh, "init": init, "transient": int(transient), "record": int(record),
             "settle_tol": settle_tolerance(solver, settle), "lyapunov": bool(lyapunov),
-            "bounds": bounds}
+            "bounds": bounds, "first_window": bool(first_window)}
     nbr = 1 if fresh else len(directions)
     plan = Plan(analysis, {**(fingerprint or {}), "param": param, "values": values,
                            "directions": list(directions), "transient": transient,
                            "record": record, "x0": x0, "v0": v0, "settle": bool(settle),
-                           "lyapunov": bool(lyapunov), "params": rows[0],
+                           "lyapunov": bool(lyapunov),
+                           "params": dict(zip(params.model.param_names, rows[0])),
                            "solver": spec["solver"], "chunk": bounds[0][1] - bounds[0][0]},
                 len(bounds), _branch_chunk, spec, chained=not fresh,
                 weights=[(b - a) * nbr * (transient + record) for a, b in bounds])
@@ -268,15 +272,16 @@ def _branch_chunk(spec, i, carry, workers=None, progress=None):
     states = (np.array(carry, dtype=np.float64, copy=True) if carry is not None
               else np.tile(init, (P.shape[0], 1)))
     out = sweep_block(P, solver, states, init, spec["transient"], spec["settle_tol"],
-                      spec["record"], spec["lyapunov"], workers=workers, progress=progress)
+                      spec["record"], spec["lyapunov"], first_window=spec["first_window"],
+                      workers=workers, progress=progress)
     if spec["fresh"]:
         del out["carry"]  # independent chunks; results (value, 1, ...)
     return out
 
 
 def sweep_block(P, solver: Solver, states, init, transient: int, settle_tol: float, record: int,
-                lyapunov: bool = False, *, floquet: bool = False, workers=None,
-                progress=None) -> dict:
+                lyapunov: bool = False, *, floquet: bool = False, first_window: bool = False,
+                workers=None, progress=None) -> dict:
     """:func:`follow` over packed parameters ``P`` (branch, value, n_par) from ``states``
     (branch, 5), then :func:`summarize` (``period``, ``max_X``, ``min_X``, ``contact``) and,
     with ``lyapunov``, ``lambda1``, ``lambda1_stderr``, ``motion`` per point (over ``record``
@@ -289,6 +294,9 @@ def sweep_block(P, solver: Solver, states, init, transient: int, settle_tol: flo
         out = follow(P, solver, states, init, transient, settle_tol, record, workers=workers,
                      progress=progress)
         out["carry"] = states.copy()
+        if first_window:  # before summarize extends the sections still converging
+            out.update(first_max_X=out["Xmax"].max(axis=2), first_S=out["S"].copy(),
+                       first_status=out["status"].copy())
         period, mx, mn, contact = summarize(out, P, solver, transient, record, workers)
         out.update(period=period, max_X=mx, min_X=mn, contact=contact)
         if lyapunov:

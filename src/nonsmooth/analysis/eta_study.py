@@ -201,8 +201,9 @@ def eta_study(params: ParamsBase, etas, *, transient: int = 300, record: int | N
             "v0": float(v0), "transient": transient, "record": record,
             "orbit_periods": orbit_periods, "spp": spp}
     per = transient + record + orbit_periods
-    plan = Plan("eta_study", {k: v for k, v in spec.items() if k != "bounds"} | {
-        "etas": eta_vals, "chunk": ETA_CHUNK}, len(bounds) + 1, _eta_chunk, spec,
+    plan = Plan("eta_study", {k: v for k, v in spec.items() if k not in ("bounds", "P", "p")} | {
+        "params": dict(zip(params.model.param_names, spec["p"])), "etas": eta_vals,
+        "chunk": ETA_CHUNK}, len(bounds) + 1, _eta_chunk, spec,
         weights=[(b - a) * per for a, b in bounds] + [per])
     parts = {}
     execute(plan, lambda i, res: parts.__setitem__(i, res), store=store, engine=engine,

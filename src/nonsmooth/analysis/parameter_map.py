@@ -165,8 +165,10 @@ def parameter_map(params: ParamsBase, x=("omega", 0.8, 1.0, 100), y=("F0", 0.15,
             "settle_tol": settle_tolerance(solver, settle), "lyapunov": lyap,
             "bounds": bounds}
     per_unit = (transient + record) * (1 if start == "fresh" else nx)
-    plan = Plan("parameter_map", {k: v for k, v in spec.items() if k != "bounds"} | {
-        "x": xname, "y": yname, "settle": bool(settle), "chunk": bounds[0][1] - bounds[0][0]},
+    plan = Plan("parameter_map", {k: v for k, v in spec.items()
+                                  if k not in ("bounds", "base", "ix", "iy")} | {
+        "params": dict(zip(params.model.param_names, spec["base"])), "x": xname, "y": yname,
+        "settle": bool(settle), "chunk": bounds[0][1] - bounds[0][0]},
         len(bounds), _map_chunk, spec, weights=[(b - a) * per_unit for a, b in bounds])
     names = {**OUTPUTS, **(LYAPUNOV_OUTPUTS if lyap else {})}
     out = {k: np.empty(nx * ny, dt) for k, dt in names.items()}

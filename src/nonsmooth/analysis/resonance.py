@@ -212,8 +212,12 @@ def resonance_curve(params: ParamsBase, omegas, *, method: str = "smooth", trans
     out = run_branches(params, w_name, omegas, solver, directions=["up", "down"],
                        transient=transient, record=record, x0=x0, v0=v0, settle=settle,
                        workers=workers, progress=progress, store=store, engine=engine,
-                       analysis="resonance")
-    freqs = characteristic_frequencies(params, solver, omegas, out, transient=transient,
+                       analysis="resonance", first_window=True)
+    # the jumps are refined from the sweeps' first recorded windows (as before the sections
+    # still converging were extended)
+    first = {"Xmax": out.pop("first_max_X")[..., None], "S": out.pop("first_S"),
+             "status": out.pop("first_status")}
+    freqs = characteristic_frequencies(params, solver, omegas, first, transient=transient,
                                        record=record, settle=settle, workers=workers,
                                        resolution=resolution, branch_tol=branch_tol)
     ds = branches_dataset(params, w_name, omegas, solver, ["up", "down"], out,

@@ -498,7 +498,8 @@ def motion_attrs() -> dict:
                       dtype=np.int8,
                       long_name="motion: periodic (a period found), chaotic (lambda1 > 0 beyond "
                                 f"{N_SIGMA:g} standard errors), quasi-periodic (no period, "
-                                "lambda1 within its error of 0), not settled")
+                                f"lambda1 within {N_SIGMA:g} standard errors of 0), not "
+                                "settled")
 
 
 def wants_lyapunov(flag, solver) -> bool:

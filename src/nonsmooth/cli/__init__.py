@@ -33,7 +33,7 @@ def _terminate(signum, frame):
 def _compile_notice() -> None:
     # the same rule as the progress bars (sweep.Progress): on a terminal, or when asked for
     if os.environ.get("NONSMOOTH_PROGRESS", "") == "1" or sys.stderr.isatty():
-        typer.echo("compiling numba kernels (first run only, about a minute)...", err=True)
+        typer.echo("compiling numba kernels (first run only, one to three minutes)...", err=True)
 
 
 def interrupted_message(code: int) -> str:
@@ -49,10 +49,11 @@ def interrupted_message(code: int) -> str:
         lost += "; " + ", ".join(f"{p} {'untouched' if p.exists() else 'not written'}"
                                  for p in untouched)
     what = "interrupted" if code == EXIT_INTERRUPTED else "terminated"
-    from ..chunks import interrupted_stores
-    if interrupted_stores:
-        path, done, total = interrupted_stores[-1]
-        chunks = f"{done} of {total} chunks in {path}"
+    from ..chunks import active_stores, saved_chunks
+    stores = [(p, n) for p, n in active_stores if p.is_dir()]
+    if stores:
+        path, total = stores[-1]
+        chunks = f"{saved_chunks(path)} of {total} chunks in {path}"
         saved = chunks if saved == "nothing" else f"{saved}, {chunks}"
         lost = ("the chunks in progress" + lost.removeprefix(
             "the computation in progress; no partial result written") +
@@ -67,7 +68,7 @@ def _resume_notice(path, done: int, total: int) -> None:
 def main(argv: list[str] | None = None) -> None:
     from .. import chunks
     planned.clear()
-    chunks.interrupted_stores.clear()
+    chunks.active_stores.clear()
     chunks.on_resume = _resume_notice
     previous = signal.signal(signal.SIGTERM, _terminate)
     _numba_cache.compile_notice = _compile_notice

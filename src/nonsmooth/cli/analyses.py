@@ -159,7 +159,7 @@ def bifurcation_cmd(
                                  atol=atol, transition=transition, settle=settle,
                                  workers=workers, progress=prog, store=store, engine=engine)
     from ..plot.bifurcation import plot_bifurcation
-    save_outputs(ds, preset, out, plot, plot_bifurcation)
+    save_outputs(ds, preset, out, plot, plot_bifurcation, store=store)
     typer.echo(f"{preset}: {param} {from_:g} ... {to:g}, {steps} values, sweep {sweep}: "
                f"{point_counts(ds)}")
     echo_written(out, plot)
@@ -215,7 +215,7 @@ def resonance_cmd(
                              progress=prog, branches="all" if all_branches else "stable",
                              store=store, engine=engine)
     from ..plot.resonance import plot_resonance
-    save_outputs(ds, preset, out, plot, plot_resonance)
+    save_outputs(ds, preset, out, plot, plot_resonance, store=store)
     a = ds.attrs
     typer.echo(f"{preset}: omega_a = {a['omega_a']:.5f} (contact starts), "
                f"omega_b = {a['omega_b']:.5f}, omega_c = {a['omega_c']:.5f} (jumps; NaN = none)")

@@ -56,7 +56,7 @@ def basins_cmd(
                     transition=transition, early_stop=not no_early_stop, workers=workers,
                     progress=bar, store=store, engine=engine)
     from ..plot.basins import plot_basins
-    save_outputs(ds, preset, out, plot, plot_basins)
+    save_outputs(ds, preset, out, plot, plot_basins, store=store)
     if orbits_plot is not None:
         from ..plot.basins import plot_attractors
         save_figure(plot_attractors(ds), orbits_plot, what="orbits-plot")

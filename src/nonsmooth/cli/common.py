@@ -142,17 +142,19 @@ def chunk_store(out: Path | None, dask: str | None = None):
     return store_for(out), check_engine(dask)
 
 
-def save_outputs(ds, preset: str, out: Path | None, plot: Path | None, figure=None) -> None:
+def save_outputs(ds, preset: str, out: Path | None, plot: Path | None, figure=None,
+                 store=None) -> None:
     """Record the preset, write the netCDF file and render ``figure(ds)`` (a plot function:
     Dataset in, Figure out) to ``plot`` where asked (each file written atomically). Once the
-    result file is written, the run's chunk store (:func:`chunk_store`) is removed."""
+    result file is written, this run's chunk ``store`` (:func:`chunk_store`) is removed."""
     from ..io import save_dataset, save_figure
 
     ds.attrs["preset"] = preset
     if out is not None:
         save_dataset(ds, out)
-        from ..chunks import remove_store, store_for
-        remove_store(store_for(out))
+        if store is not None:
+            from ..chunks import remove_store
+            remove_store(store)
     if plot is not None and figure is not None:
         save_figure(figure(ds), plot)
 

@@ -88,7 +88,7 @@ def eta_study_cmd(
         nm for i, nm in enumerate(m.mode_names) if m.contact_modes >> i & 1) or "contact"
     col = "Gamma+" if m.name == "support" else "contact"
     from ..plot.eta_study import plot_eta_study
-    save_outputs(ds, preset, out, plot, plot_eta_study)
+    save_outputs(ds, preset, out, plot, plot_eta_study, store=store)
     typer.echo(f"{preset}: exact model period {int(ds.exact_period) or 'none'}, "
                f"{'reaches' if int(ds.exact_reaches_gamma_plus) else 'never reaches'} {full}")
     typer.echo(f"{'eta':>10s} {col:>7s} {'period':>7s} {'distance':>10s}  agrees")

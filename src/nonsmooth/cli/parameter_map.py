@@ -79,7 +79,7 @@ def map_cmd(
                            workers=workers, progress=prog, store=store, engine=engine,
                            chunk=chunk)
     from ..plot.parameter_map import plot_lambda1_map, plot_parameter_map
-    save_outputs(ds, preset, out, plot, plot_parameter_map)
+    save_outputs(ds, preset, out, plot, plot_parameter_map, store=store)
     if lambda_plot is not None:
         from ..io import save_figure
         save_figure(plot_lambda1_map(ds), lambda_plot, what="lambda-plot")

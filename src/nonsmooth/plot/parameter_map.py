@@ -48,7 +48,10 @@ def plot_parameter_map(ds, ax=None):
     ax.imshow(code, origin="lower", aspect="auto", extent=_extent(ds), cmap=cmap,
               vmin=-0.5, vmax=len(names) - 0.5, interpolation="nearest")
     counts = np.bincount(code.ravel(), minlength=len(names))
-    handles = [Patch(color=REGIME_COLORS[k], label=f"{names[k]} ({100 * counts[k] / code.size:.1f}%)")
+    def share(c):
+        pct = 100.0 * c / code.size
+        return f"{pct:.1f}%" if pct >= 0.05 else "<0.1%"
+    handles = [Patch(color=REGIME_COLORS[k], label=f"{names[k]} ({share(counts[k])})")
                for k in range(len(names)) if counts[k]]
     ax.legend(handles=handles, loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=8,
               frameon=False)

@@ -116,7 +116,7 @@ from ...io import check_memory, flag_attrs, provenance_attrs, status_flags
 from ...kernels import Solver, new_state, output_buffers, run
 from ...models.base import ParamsBase
 from ...simulate import check_float, check_int, check_params
-from ...sweep import resolve_workers, threads
+from ...sweep import parallel_chunks, resolve_workers, threads
 from ..periodicity import section_tolerance
 from ._core import (_HOLD, _K, _N_REC, _Q, _RES, _RES_FAILED, _RES_NEW, _RUNNING, _STATUS,
                     LABEL_UNDECIDED, N_CONFIRM, _run_round)
@@ -208,7 +208,8 @@ def basins(params: ParamsBase, *, x=(-3.0, 3.0), v=(-3.0, 3.0), grid=400, method
             "v": (v_lo, v_hi), "nx": nx, "nv": nv, "transient": transient,
             "max_periods": max_periods, "max_period": max_period, "tol": tol,
             "certified": certified, "rounds": rounds}
-    plan = Plan("basins", {k: v for k, v in spec.items() if k != "rounds"} | {
+    plan = Plan("basins", {k: v for k, v in spec.items() if k not in ("rounds", "pk")} | {
+        "params": dict(zip(params.model.param_names, pk)),
         "early_stop": bool(early_stop), "samples_per_period": spp,
         "lyapunov": bool(wants_lyapunov(lyapunov, solver))}, len(rounds), _basins_round,
         spec, chained=True, weights=[b - a for a, b in rounds])
@@ -216,6 +217,7 @@ def basins(params: ParamsBase, *, x=(-3.0, 3.0), v=(-3.0, 3.0), grid=400, method
     used = np.zeros(n, np.int32)
     status = np.zeros(n, np.int64)
     last = {}
+    clouds = _Clouds(x_lo, x_hi, v_lo, v_hi, n)
 
     def collect(i, res):
         a, b = rounds[i]
@@ -223,9 +225,14 @@ def basins(params: ParamsBase, *, x=(-3.0, 3.0), v=(-3.0, 3.0), grid=400, method
         used[a:b] = res["used"]
         status[a:b] = res["status"]
         last["carry"] = res["carry"]
-    execute(plan, collect, store=store, engine=engine, workers=nw,
-            progress=None if progress is None else (lambda d, t: progress(d, n)))
-    found, clouds, lat, cert = (last["carry"][k] for k in ("found", "clouds", "lat", "cert"))
+        if res["cloud_pos"].size:  # the round's undecided trajectories, in round order
+            clouds.add(res["cloud_pos"], res["cloud_X"], res["cloud_V"], res["cloud_state"])
+    try:
+        execute(plan, collect, store=store, engine=engine, workers=nw,
+                progress=None if progress is None else (lambda d, t: progress(d, n)))
+    finally:
+        _order.cache_clear()  # the visiting order of a large grid is not kept after the run
+    found, lat, cert = (last["carry"][k] for k in ("found", "lat", "cert"))
     with threads(nw):
         for members, state in clouds.groups():
             chaos = _confirm_chaos(solver, pk, state, tol, max_period, scale)
@@ -279,47 +286,46 @@ def _order(nx: int, nv: int):
 
 def _basins_round(spec, i, carry, workers=None, progress=None):
     """Round ``i`` of :func:`basins` (a chained ``chunks.Plan`` task): the records of its
-    points and, as ``carry``, what later rounds depend on (the attractors found, their
-    certified discs, the lattice, the chaotic candidates)."""
+    points, its still undecided trajectories (``cloud_*``: the client groups them into
+    chaotic candidates, ``_Clouds``) and, as ``carry``, what later rounds depend on (the
+    attractors found, their certified discs, the lattice)."""
     from ...chunks import solver_from_spec
     solver = solver_from_spec(spec["solver"])
     (x_lo, x_hi), (v_lo, v_hi), nx, nv = spec["x"], spec["v"], spec["nx"], spec["nv"]
     n = nx * nv
     order, first = _order(nx, nv)
     if carry is None:
-        carry = {"found": _Attractors(spec["tol"]), "clouds": _Clouds(x_lo, x_hi, v_lo, v_hi, n),
+        carry = {"found": _Attractors(spec["tol"]),
                  "lat": _Lattice(x_lo, x_hi, v_lo, v_hi, nx, nv, first), "cert": {"periods": 0}}
-    found, clouds, lat, cert = (carry[k] for k in ("found", "clouds", "lat", "cert"))
+    found, lat, cert = (carry[k] for k in ("found", "lat", "cert"))
     a, b = spec["rounds"][i]
     idx = order[a:b]
     X0 = np.linspace(x_lo, x_hi, nx)[idx // nv]
     V0 = np.linspace(v_lo, v_hi, nv)[idx % nv]
     pk, certified = spec["pk"], spec["certified"]
-    with threads(workers):
-        old_chunk = nb.get_parallel_chunksize()
-        nb.set_parallel_chunksize(8)
-        try:
-            rec = _run_round_points(solver, pk, X0, V0, a, n, spec["max_periods"],
-                                    spec["transient"], spec["tol"], spec["max_period"],
-                                    certified, found, lat, clouds, _Pace(2 * first),
-                                    None if progress is None else
-                                    (lambda d, _t: progress(d - a, b - a)))
-            if certified and not all(found.certified):
-                _certify_all(found, solver, pk, cert)
-                lat.stale = True
-            if certified and lat.stale and lat.active and b >= lat.start_after:
-                lat.certify(found, solver, pk, cert)
-        finally:
-            nb.set_parallel_chunksize(old_chunk)
+    with threads(workers), parallel_chunks(8):
+        rec, cloud = _run_round_points(solver, pk, X0, V0, a, n, spec["max_periods"],
+                                       spec["transient"], spec["tol"], spec["max_period"],
+                                       certified, found, lat, _Pace(2 * first),
+                                       None if progress is None else
+                                       (lambda d, _t: progress(d - a, b - a)))
+        if certified and not all(found.certified):
+            _certify_all(found, solver, pk, cert)
+            lat.stale = True
+        if certified and lat.stale and lat.active and b >= lat.start_after:
+            lat.certify(found, solver, pk, cert)
     return {"label": rec[:, _RES], "used": rec[:, _K], "status": rec[:, _STATUS],
-            "carry": carry}
+            "cloud_pos": cloud[0], "cloud_X": cloud[1], "cloud_V": cloud[2],
+            "cloud_state": cloud[3], "carry": carry}
 
 
 def _run_round_points(solver, pk, X0, V0, done_before, n, max_periods, transient, tol,
-                      max_period, certified, found, lat, clouds, pace, progress):
+                      max_period, certified, found, lat, pace, progress):
     """Decide the points of one round; returns their records (m, _N_REC): rec[:, _RES] the
     label in discovery numbering (-1 undecided or failed), rec[:, _K] the periods used,
-    rec[:, _STATUS] the kernel status.
+    rec[:, _STATUS] the kernel status; and the undecided trajectories not near a known
+    attractor, for ``_Clouds.add``: (processing positions, their last section points X, V,
+    their kernel states).
 
     The points are followed in slices (compiled calls of about ``SLICE_SECONDS``, sized by
     ``pace`` from the measured speed; a round shorter than that is one call) against the
@@ -382,10 +388,9 @@ def _run_round_points(solver, pk, X0, V0, done_before, n, max_periods, transient
     und = np.flatnonzero(recs[:, _RES] == LABEL_UNDECIDED)
     c = min(L, max_periods)
     und = und[~found.near(bufs[und, 0, (recs[und, _K] - 1) % L], bufs[und, 1, (recs[und, _K] - 1) % L])]
-    if und.size:
-        clouds.add(done_before + und, bufs[und, 0, :c], bufs[und, 1, :c], states[und])
+    cloud = (done_before + und, bufs[und, 0, :c], bufs[und, 1, :c], states[und])
     recs[recs[:, _RES] == _RES_FAILED, _RES] = LABEL_UNDECIDED
-    return recs
+    return recs, cloud
 
 
 def _check_range(name, r):

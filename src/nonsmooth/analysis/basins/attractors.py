@@ -109,7 +109,9 @@ class _Clouds:
 
     def __init__(self, x_lo, x_hi, v_lo, v_hi, n):
         self.geo = (x_lo, v_lo, (x_hi - x_lo) / _CLOUD_CELLS, (v_hi - v_lo) / _CLOUD_CELLS)
-        self.first_cell = np.full(n, -1, np.int64)  # by processing position; -1 = not a member
+        # members (processing positions, increasing) and the first cell of each
+        self.pos = np.zeros(0, np.int64)
+        self.first_cell = np.zeros(0, np.int64)
         self.edges = np.zeros((0, 2), np.int64)
         self.seen = np.zeros(0, np.int64)
         self.seeds = {}  # processing position -> kernel state
@@ -126,7 +128,8 @@ class _Clouds:
         keep = np.ones(flat.size, np.bool_)
         keep[1:] = (flat[1:] != flat[:-1]) | (rows[1:] != rows[:-1])
         rows, flat = rows[keep], flat[keep]
-        self.first_cell[pos] = ids[:, 0]
+        self.pos = np.concatenate([self.pos, np.asarray(pos, np.int64)])
+        self.first_cell = np.concatenate([self.first_cell, ids[:, 0]])
         self.edges = np.unique(np.concatenate([self.edges, np.stack([ids[rows, 0], flat], axis=1)]),
                                axis=0)
         cells, first = np.unique(flat, return_index=True)  # first: the earliest row per cell
@@ -147,11 +150,12 @@ class _Clouds:
         b = np.searchsorted(cells, self.edges[:, 1])
         graph = coo_matrix((np.ones(len(a)), (a, b)), shape=(len(cells), len(cells)))
         comp = connected_components(graph, directed=False)[1]
-        members = np.flatnonzero(self.first_cell >= 0)
-        mcomp = comp[np.searchsorted(cells, self.first_cell[members])]
+        order = np.argsort(self.pos, kind="stable")
+        members, first = self.pos[order], self.first_cell[order]
+        mcomp = comp[np.searchsorted(cells, first)]
         out, done = [], set()
         for s in sorted(self.seeds):
-            c = int(comp[np.searchsorted(cells, self.first_cell[s])])
+            c = int(comp[np.searchsorted(cells, first[np.searchsorted(members, s)])])
             if c not in done:
                 done.add(c)
                 out.append((members[mcomp == c], self.seeds[s]))
