@@ -51,7 +51,16 @@ RETRIES = 3
 @dataclasses.dataclass
 class Plan:
     """A chunked computation. ``fingerprint``: JSON-able inputs that determine the result
-    (a store of another fingerprint is refused); ``weights``: work per chunk (progress)."""
+    (a store of another fingerprint is refused); ``weights``: work per chunk (progress).
+
+    ``chained`` (all chunks one chain) or ``chains`` (a chain id per chunk, None for an
+    independent chunk): a chunk of a chain starts from the ``carry`` of the chain's previous
+    chunk (in index order). Chains are independent of each other: Dask runs them side by
+    side. ``stream(spec, todo, carries, emit, workers=None, progress=None)``, optional, runs
+    on the embedded engine all the pending chunks of all chains at once (``todo``: chain ->
+    chunk indices, ``carries``: chain -> carry) and calls ``emit(i, result)`` as each chunk
+    is finished: the chains then never wait for each other at chunk boundaries (each chunk
+    must equal what ``task`` gives)."""
 
     analysis: str
     fingerprint: dict
@@ -60,10 +69,22 @@ class Plan:
     spec: Any
     chained: bool = False
     weights: list | None = None
+    chains: list | None = None
+    stream: Callable | None = None
+
+    def __post_init__(self):
+        if self.chains is None and self.chained:
+            self.chains = [0] * self.n_chunks
+        self.chained = self.chains is not None and any(c is not None for c in self.chains)
+
+    def chain_of(self, i: int):
+        return None if self.chains is None else self.chains[i]
 
     def manifest(self) -> dict:
         return {"analysis": self.analysis, "nonsmooth_version": __version__,
-                "n_chunks": int(self.n_chunks), "chained": bool(self.chained),
+                "n_chunks": int(self.n_chunks),
+                "chains": None if self.chains is None else [
+                    None if c is None else int(c) for c in self.chains],
                 "fingerprint": _jsonable(self.fingerprint)}
 
 
@@ -355,9 +376,9 @@ def saved_chunks(path) -> int:
 
 def execute(plan: Plan, collect: Callable[[int, dict], None], *, store=None, engine=None,
             workers=None, progress=None) -> None:
-    """Compute every chunk of ``plan`` and hand each result to ``collect(i, result)``, in
-    chunk order for a chained plan and in order of completion otherwise (``collect`` must put
-    each chunk in its place). With ``store`` (a directory, see :class:`ChunkStore`) the
+    """Compute every chunk of ``plan`` and hand each result to ``collect(i, result)`` (in
+    chunk order within a chain, otherwise in order of completion: ``collect`` must put each
+    chunk in its place). With ``store`` (a directory, see :class:`ChunkStore`) the
     finished chunks are written there and the chunks already there are read instead of
     computed. ``progress(done, total)`` counts ``plan.weights``. A Dask engine is connected
     before the store is opened, so an unreachable scheduler leaves nothing behind."""
@@ -373,11 +394,6 @@ def execute(plan: Plan, collect: Callable[[int, dict], None], *, store=None, eng
 
 def _execute(plan, collect, st, client, workers, progress):
     done = st.done() if st is not None else set()
-    if plan.chained:  # only the prefix of finished chunks counts
-        done = set(range(next((i for i in range(plan.n_chunks) if i not in done),
-                              plan.n_chunks)))
-    if done and on_resume is not None:
-        on_resume(st.path, len(done), plan.n_chunks)
     weights = [float(w) for w in (plan.weights or [1.0] * plan.n_chunks)]
     total = sum(weights) or 1.0
     finished = [0.0]
@@ -386,24 +402,64 @@ def _execute(plan, collect, st, client, workers, progress):
         if progress is not None:
             progress(int(round(finished[0] + extra)), int(round(total)))
 
-    def finish(i, res, write=True):
+    def finish(i, res, write=True, quiet=False):
         if write and st is not None:
             st.write(i, res)
         collect(i, res)
         finished[0] += weights[i]
-        report()
+        if not quiet:
+            report()
 
-    carry = None
-    todo = []
+    # finished chunks: independent ones all; of a chain, the prefix of finished chunks
+    members: dict = {}
     for i in range(plan.n_chunks):
-        if i in done and (not plan.chained or not todo):  # chained: the finished prefix
-            res = st.read(i)
-            carry = res.get("carry")
-            finish(i, res, write=False)
-        else:
-            todo.append(i)
-    if client is None:
-        for i in todo:
+        members.setdefault(plan.chain_of(i), []).append(i)
+    carries, todo, reuse = {}, {}, []
+    for c, idx in members.items():
+        if c is None:
+            reuse += [i for i in idx if i in done]
+            todo[None] = [i for i in idx if i not in done]
+            continue
+        k = next((q for q, i in enumerate(idx) if i not in done), len(idx))
+        reuse += idx[:k]
+        carries[c] = None
+        if idx[k:]:
+            todo[c] = idx[k:]
+    if reuse and on_resume is not None:
+        on_resume(st.path, len(reuse), plan.n_chunks)
+    for i in sorted(reuse):
+        res = st.read(i)
+        if plan.chain_of(i) is not None:
+            carries[plan.chain_of(i)] = res.get("carry")
+        finish(i, res, write=False)
+    todo = {c: v for c, v in todo.items() if v}
+    if client is not None:
+        try:
+            _run_dask(client, plan, todo, carries, finish)
+        except (KeyboardInterrupt, NonsmoothError):
+            raise
+        except Exception as exc:  # a killed worker beyond the scheduler's allowed failures,
+            # a lost connection, a cancelled task: one line, and what is saved
+            saved = (f"; {saved_chunks(st.path)} of {plan.n_chunks} chunks saved in "
+                     f"{st.path}, run again to resume") if st is not None else ""
+            reason = str(exc).splitlines()[0][:160] if str(exc) else ""
+            raise NonsmoothError(f"dask: the cluster failed ({type(exc).__name__}: {reason})"
+                                 f"{saved}") from None
+        return
+    chained = {c: v for c, v in todo.items() if c is not None}
+    if chained and plan.stream is not None:
+        base, left = finished[0], sum(weights[i] for v in chained.values() for i in v)
+
+        def inner(d, t):
+            if progress is not None:
+                progress(int(round(base + left * d / t if t else base)), int(round(total)))
+        plan.stream(plan.spec, chained, {c: carries[c] for c in chained},
+                    lambda i, res: finish(i, res, quiet=True), workers=workers,
+                    progress=inner if progress is not None else None)
+        chained = {}
+    for c, idx in list(chained.items()) + ([(None, todo[None])] if None in todo else []):
+        carry = carries.get(c)
+        for i in idx:
             w = weights[i]
 
             def inner(d, t, _w=w):
@@ -412,18 +468,6 @@ def _execute(plan, collect, st, client, workers, progress):
                             progress=inner if progress is not None else None)
             carry = res.get("carry")
             finish(i, res)
-        return
-    try:
-        _run_dask(client, plan, todo, carry, finish)
-    except (KeyboardInterrupt, NonsmoothError):
-        raise
-    except Exception as exc:  # a killed worker beyond the scheduler's allowed failures, a
-        # lost connection, a cancelled task: one line, and what is saved
-        saved = (f"; {saved_chunks(st.path)} of {plan.n_chunks} chunks saved in {st.path}, "
-                 f"run again to resume") if st is not None else ""
-        reason = str(exc).splitlines()[0][:160] if str(exc) else ""
-        raise NonsmoothError(f"dask: the cluster failed ({type(exc).__name__}: {reason})"
-                             f"{saved}") from None
 
 
 def _submit(client, plan, spec, i, carry):
@@ -431,43 +475,40 @@ def _submit(client, plan, spec, i, carry):
                          key=f"nonsmooth-{plan.analysis}-{i}-{uuid.uuid4().hex[:8]}")
 
 
-def _run_dask(client, plan, todo, carry, finish):
+def _run_dask(client, plan, todo, carries, finish):
+    """Every chain's chunks one after the other (each from its predecessor's carry), chains
+    and independent chunks side by side, at most a window of independent chunks in flight."""
     from distributed import as_completed
     if not todo:
         return
     futures = []
     try:
-        if plan.chained:
-            for i in todo:
-                fut = _submit(client, plan, plan.spec, i, carry)
-                futures = [fut]
-                res = fut.result()
-                carry = res.get("carry")
-                finish(i, res)
-                fut.release()
-            return
         nthreads = sum(client.nthreads().values()) or 1
         window = max(2, IN_FLIGHT_PER_THREAD * nthreads)
         spec = plan.spec
         if _big(spec):  # one copy per worker, not one per task (a list: scattered whole)
             [spec] = client.scatter([plan.spec], broadcast=True, hash=False)
-        queue = list(todo)
+        queues = {c: list(v) for c, v in todo.items()}
         index = {}
 
-        def submit(i):
-            fut = _submit(client, plan, spec, i, None)
-            index[fut.key] = i
+        def submit(c, carry=None):
+            i = queues[c].pop(0)
+            fut = _submit(client, plan, spec, i, carry)
+            index[fut.key] = (i, c)
             futures.append(fut)
             return fut
 
-        ac = as_completed([submit(queue.pop(0)) for _ in range(min(window, len(queue)))])
+        first = [submit(c, carries.get(c)) for c in queues if c is not None]
+        free = queues.get(None, [])
+        first += [submit(None) for _ in range(min(window, len(free)))]
+        ac = as_completed(first)
         for fut in ac:
             res = fut.result()
-            i = index.pop(fut.key)
+            i, c = index.pop(fut.key)
             fut.release()
             futures.remove(fut)
-            if queue:
-                ac.add(submit(queue.pop(0)))
+            if queues.get(c):
+                ac.add(submit(c, res.get("carry") if c is not None else None))
             finish(i, res)
     finally:  # an interruption or a failure: nothing of this run stays on the cluster
         if futures:

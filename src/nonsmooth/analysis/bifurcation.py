@@ -26,6 +26,7 @@ from ..integrate.contract import MODEL_FNS_TYPE
 from ..kernels import Solver, mode_holds, run
 from ..models.base import ParamsBase
 from ..params import check_param_name
+from ..sweep import parallel_chunks
 from .poincare import (MAX_PERIOD, PERIOD_LONG_NAME, SETTLE_WINDOW, classify_many, settle,
                        settle_tolerance)
 
@@ -153,13 +154,16 @@ def check_sweep_memory(n_values: int, n_branches: int, record: int) -> None:
 
 
 def follow(P, solver: Solver, states, init, transient: int, settle_tol: float, record: int,
-           *, workers=None, progress=None, group: int | None = None):
+           *, workers=None, progress=None, group: int | None = None, start=None,
+           on_slice=None):
     """Run :func:`continuation` over the packed parameters ``P`` (branch, value, 7) from
     ``states`` (branch, 5; updated in place) in time slices (``sweep.Slicer``: each compiled
     call returns to Python after about 0.1 s, so Ctrl-C stops it and progress is reported,
     ``progress(done, total)`` in periods of the planned work), ``group`` branches at a time.
     Returns dict of X, V, R, M, Xmax, Xmin (branch, value, record), ``status`` and ``used``
-    (branch, value) and ``S`` (branch, value, 5)."""
+    (branch, value) and ``S`` (branch, value, 5). ``start``: the value index each branch
+    starts at (default 0; the outputs before it are left unset); ``on_slice(values_done,
+    out)`` is called after each slice with the number of values each branch has finished."""
     from ..sweep import Slicer, threads
     nbr, nval = P.shape[0], P.shape[1]
     X = np.empty((nbr, nval, record))
@@ -168,6 +172,8 @@ def follow(P, solver: Solver, states, init, transient: int, settle_tol: float, r
            "Xmin": np.empty_like(X), "status": np.zeros((nbr, nval), np.int64),
            "used": np.zeros((nbr, nval), np.int64), "S": np.empty((nbr, nval, states.shape[1]))}
     prog = np.zeros((nbr, N_PROG), np.int64)
+    if start is not None:
+        prog[:, PG_VALUE] = start
     opts = solver.opts()
     per_value = transient + record
     group = nbr if group is None else max(1, group)
@@ -186,12 +192,15 @@ def follow(P, solver: Solver, states, init, transient: int, settle_tol: float, r
                                     np.where(g[:, PG_PHASE] == _SETTLE, g[:, PG_DONE], 0))
                     progress(int(np.sum(g[:, PG_VALUE] * per_value + part)),
                              nbr * nval * per_value)
+                if on_slice is not None:
+                    on_slice(prog[:, PG_VALUE], out)
     return out
 
 
-#: Values per chunk of a continuation sweep (up/down: a chunk is this many values of every
-#: direction, continued from the previous chunk's states) and of a fresh sweep (independent
-#: chunks). Chunks are the unit of resumption (``chunks``); they never change a number.
+#: Values per chunk of a continuation sweep (each direction is a chain of chunks, each chunk
+#: continued from the state its predecessor ended with; the directions never wait for each
+#: other) and of a fresh sweep (independent chunks). Chunks are the unit of resumption
+#: (``nonsmooth.chunks``); they never change a number.
 BRANCH_CHUNK = 25
 FRESH_CHUNK = 100
 
@@ -210,11 +219,14 @@ def run_branches(params: ParamsBase, param: str, values, solver: Solver, *, dire
     ``first_S`` and ``first_status``: max X, state and status of the first recorded window,
     before sections still converging were extended (what the resonance refinement starts from).
 
-    The values are computed in chunks (:data:`BRANCH_CHUNK` values of every direction, each
+    The sweeps are computed in chunks (:data:`BRANCH_CHUNK` values of every direction, each
     chunk continued from the states the previous one ended with; a fresh sweep in independent
     chunks of :data:`FRESH_CHUNK`) by ``engine`` (``chunks.execute``); with ``store`` (a
-    directory) finished chunks are written there and a re-run resumes from them.
-    ``progress(done, total)`` is called after each time slice (see :func:`follow`)."""
+    directory) finished chunks are written there and a re-run resumes from them. The
+    classification (:func:`classify_block`) then runs once over all values, here: its
+    extensions of the sections still converging and its lambda1 run in parallel over every
+    point of the sweep, not a chunk's few. ``progress(done, total)`` is called after each
+    time slice (see :func:`follow`)."""
     from ..chunks import Plan, chunk_bounds, execute, plan_solver
     from ..kernels import new_state
     values = np.asarray(values, dtype=np.float64)
@@ -224,76 +236,130 @@ def run_branches(params: ParamsBase, param: str, values, solver: Solver, *, dire
     fresh = list(directions) == ["fresh"]
     orders = [np.arange(nv) if d != "down" else np.arange(nv)[::-1] for d in directions]
     bounds = chunk_bounds(nv, FRESH_CHUNK if fresh else BRANCH_CHUNK)
+    nk = len(bounds)
     spec = {"solver": plan_solver(solver, engine), "rows": rows, "orders": orders,
             "fresh": fresh, "init": init, "transient": int(transient), "record": int(record),
-            "settle_tol": settle_tolerance(solver, settle), "lyapunov": bool(lyapunov),
-            "bounds": bounds, "first_window": bool(first_window)}
+            "settle_tol": settle_tolerance(solver, settle), "bounds": bounds}
     nbr = 1 if fresh else len(directions)
     plan = Plan(analysis, {**(fingerprint or {}), "param": param, "values": values,
                            "directions": list(directions), "transient": transient,
                            "record": record, "x0": x0, "v0": v0, "settle": bool(settle),
-                           "lyapunov": bool(lyapunov),
                            "params": dict(zip(params.model.param_names, rows[0])),
                            "solver": spec["solver"], "chunk": bounds[0][1] - bounds[0][0]},
-                len(bounds), _branch_chunk, spec, chained=not fresh,
-                weights=[(b - a) * nbr * (transient + record) for a, b in bounds])
-    out = {}
+                nbr * nk, _branch_chunk, spec,
+                chains=None if fresh else [i // nk for i in range(nbr * nk)],
+                stream=None if fresh else _branch_stream,
+                weights=[(b - a) * (transient + record) for _ in range(nbr) for a, b in bounds])
+    X = np.empty((nbr, nv, record))
+    out = {"X": X, "V": np.empty_like(X), "R": np.empty(X.shape, np.int8),
+           "M": np.empty(X.shape, np.uint8), "Xmax": np.empty_like(X),
+           "Xmin": np.empty_like(X), "status": np.zeros((nbr, nv), np.int64),
+           "used": np.zeros((nbr, nv), np.int64), "S": np.empty((nbr, nv, init.size)),
+           "state": np.tile(init, (nbr, 1))}
 
     def collect(i, res):
-        a, b = bounds[i]
-        if not out:
-            for k, v in res.items():
-                if k != "carry":
-                    out[k] = np.empty((nbr, nv) + v.shape[2:], v.dtype)
-        for k, v in res.items():
-            if k == "carry":
-                out["state"] = v
-            elif fresh:
-                out[k][0, a:b] = v[:, 0]
+        d, k = divmod(i, nk)
+        a, b = bounds[k]
+        for key, v in res.items():
+            if key == "carry":
+                if k == nk - 1:
+                    out["state"][d] = v
             else:
-                for j, o in enumerate(orders):
-                    out[k][j, o[a:b]] = v[j]
+                out[key][d, orders[d][a:b]] = v
     execute(plan, collect, store=store, engine=engine, workers=workers, progress=progress)
     if fresh:
         out["state"] = out["S"][0].copy()
+    P = np.ascontiguousarray(np.broadcast_to(rows[None], (nbr,) + rows.shape))
+    classify_block(out, P, solver, transient, record, lyapunov, first_window=first_window,
+                   workers=workers)
     return out
+
+
+def _branch_rows(spec, d, a, b):
+    """Packed parameters of values a ... b-1 of direction d (its sweep order)."""
+    return spec["rows"][spec["orders"][d][a:b]]
 
 
 def _branch_chunk(spec, i, carry, workers=None, progress=None):
-    """Chunk ``i`` of :func:`run_branches` (a ``chunks.Plan`` task)."""
+    """Chunk ``i`` of :func:`run_branches` (a ``chunks.Plan`` task): a block of values of one
+    direction (fresh: independent values), continued from ``carry``."""
     from ..chunks import solver_from_spec
     solver = solver_from_spec(spec["solver"])
-    a, b = spec["bounds"][i]
-    rows, init = spec["rows"], spec["init"]
+    nk = len(spec["bounds"])
+    d, k = divmod(i, nk)
+    a, b = spec["bounds"][k]
+    init = spec["init"]
     if spec["fresh"]:
-        P = np.ascontiguousarray(rows[a:b][:, None, :])
+        P = np.ascontiguousarray(_branch_rows(spec, 0, a, b)[:, None, :])
     else:
-        P = np.ascontiguousarray(np.stack([rows[o[a:b]] for o in spec["orders"]]))
-    states = (np.array(carry, dtype=np.float64, copy=True) if carry is not None
+        P = np.ascontiguousarray(_branch_rows(spec, d, a, b)[None])
+    states = (np.array(carry, dtype=np.float64, copy=True)[None] if carry is not None
               else np.tile(init, (P.shape[0], 1)))
-    out = sweep_block(P, solver, states, init, spec["transient"], spec["settle_tol"],
-                      spec["record"], spec["lyapunov"], first_window=spec["first_window"],
-                      workers=workers, progress=progress)
+    with parallel_chunks():
+        out = follow(P, solver, states, init, spec["transient"], spec["settle_tol"],
+                     spec["record"], workers=workers, progress=progress)
     if spec["fresh"]:
-        del out["carry"]  # independent chunks; results (value, 1, ...)
-    return out
+        return {key: v[:, 0] for key, v in out.items()}  # (value, ...)
+    res = {key: v[0] for key, v in out.items()}
+    res["carry"] = states[0].copy()
+    return res
+
+
+def _branch_stream(spec, todo, carries, emit, workers=None, progress=None):
+    """All the pending chunks of the continuation directions in one :func:`follow` (a
+    ``chunks.Plan`` stream): every direction runs on without waiting for the others at chunk
+    boundaries, and each block is emitted (with the state after its last value as carry) as
+    soon as its direction has finished it. Each chunk equals :func:`_branch_chunk`'s."""
+    from ..chunks import solver_from_spec
+    solver = solver_from_spec(spec["solver"])
+    bounds, nk, init = spec["bounds"], len(spec["bounds"]), spec["init"]
+    dirs = sorted(todo)
+    nv = spec["rows"].shape[0]
+    P = np.ascontiguousarray(np.stack([_branch_rows(spec, d, 0, nv) for d in dirs]))
+    states = np.stack([init if carries[d] is None else np.asarray(carries[d], np.float64)
+                       for d in dirs])
+    pending = [list(todo[d]) for d in dirs]
+    start = np.array([bounds[q[0] % nk][0] for q in pending], np.int64)
+
+    def on_slice(values_done, out):
+        for j, d in enumerate(dirs):
+            while pending[j] and values_done[j] >= bounds[pending[j][0] % nk][1]:
+                i = pending[j].pop(0)
+                a, b = bounds[i % nk]
+                res = {key: v[j, a:b].copy() for key, v in out.items()}
+                res["carry"] = out["S"][j, b - 1].copy()
+                emit(i, res)
+    with parallel_chunks():
+        follow(P, solver, states, init, spec["transient"], spec["settle_tol"], spec["record"],
+               workers=workers, progress=progress, start=start, on_slice=on_slice)
 
 
 def sweep_block(P, solver: Solver, states, init, transient: int, settle_tol: float, record: int,
-                lyapunov: bool = False, *, floquet: bool = False, first_window: bool = False,
-                workers=None, progress=None) -> dict:
+                lyapunov: bool = False, *, floquet: bool = False, workers=None,
+                progress=None) -> dict:
     """:func:`follow` over packed parameters ``P`` (branch, value, n_par) from ``states``
-    (branch, 5), then :func:`summarize` (``period``, ``max_X``, ``min_X``, ``contact``) and,
-    with ``lyapunov``, ``lambda1``, ``lambda1_stderr``, ``motion`` per point (over ``record``
-    further periods of its attractor, ``analysis.stability.lambda1_points``; with ``floquet``
-    a periodic point's lambda1 is ln|mu_1| / (p T) of its leading Floquet multiplier instead,
-    with stderr 0, ``stability.floquet_lambda1_points``). ``carry``: the states after the last
-    value of each branch. Parallel loops are scheduled dynamically (``sweep.parallel_chunks``)."""
-    from ..sweep import parallel_chunks
+    (branch, 5), then :func:`classify_block`. ``carry``: the states after the last value of
+    each branch. Parallel loops are scheduled dynamically (``sweep.parallel_chunks``)."""
     with parallel_chunks():
         out = follow(P, solver, states, init, transient, settle_tol, record, workers=workers,
                      progress=progress)
         out["carry"] = states.copy()
+        classify_block(out, P, solver, transient, record, lyapunov, floquet=floquet,
+                       workers=workers)
+    return out
+
+
+def classify_block(out, P, solver: Solver, transient: int, record: int, lyapunov: bool = False,
+                   *, floquet: bool = False, first_window: bool = False, workers=None) -> dict:
+    """Add to the :func:`follow` output ``out`` (points (branch, value), packed parameters
+    ``P`` (branch, value, n_par)) the classification of :func:`summarize` (``period``,
+    ``max_X``, ``min_X``, ``contact``; sections still converging are extended in ``out``) and,
+    with ``lyapunov``, ``lambda1``, ``lambda1_stderr``, ``motion`` per point (over ``record``
+    further periods of its attractor, ``analysis.stability.lambda1_points``; with ``floquet``
+    a periodic point's lambda1 is ln|mu_1| / (p T) of its leading Floquet multiplier instead,
+    with stderr 0, ``stability.floquet_lambda1_points``). With ``first_window``, first
+    ``first_max_X``, ``first_S``, ``first_status`` of the window before any extension."""
+    with parallel_chunks():
         if first_window:  # before summarize extends the sections still converging
             out.update(first_max_X=out["Xmax"].max(axis=2), first_S=out["S"].copy(),
                        first_status=out["status"].copy())
