@@ -105,8 +105,8 @@ def test_every_sweep_resumes_bit_identically(analysis, tmp_path):
         "bifurcation": lambda **kw: ns.bifurcation_diagram(
             P3, "omega", np.linspace(0.85, 0.95, 60), transient=100, record=30,
             method="exact", **kw),
-        "basins": lambda **kw: ns.basins(ns.preset("fig7"), grid=40, method="exact",
-                                         max_periods=200, **kw),
+        "basins": lambda **kw: ns.basins(ns.preset("fig7"), grid=30, method="exact",
+                                         max_periods=200, lyapunov=False, **kw),
         "eta_study": lambda **kw: ns.eta_study(ns.preset("fig4"), [1e-2, 1e-3], transient=50,
                                                record=20, orbit_periods=1, **kw),
         "resonance": lambda **kw: ns.resonance_curve(ns.preset("table1"),
