@@ -210,3 +210,15 @@ def test_plots_of_a_map(tmp_path):
     save_figure(fig, tmp_path / "m.png")
     save_figure(plot_lambda1_map(m), tmp_path / "l.png")
     assert os.path.getsize(tmp_path / "m.png") > 1000
+
+
+def test_signals_during_a_compiled_call_are_delivered_after_it():
+    import signal as sg
+    from nonsmooth.sweep import deferred_interrupts
+    inside = []
+    with pytest.raises(KeyboardInterrupt):
+        with deferred_interrupts():
+            os.kill(os.getpid(), sg.SIGINT)
+            inside.append("still running")  # held: the block ends normally first
+    assert inside == ["still running"]
+    assert sg.getsignal(sg.SIGINT) is sg.default_int_handler

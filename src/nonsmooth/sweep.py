@@ -10,6 +10,8 @@ from __future__ import annotations
 
 import contextlib
 import os
+import signal
+import threading
 import time
 
 import numba as nb
@@ -40,6 +42,34 @@ def _run_many(method, fns, P, opts, states, per_period, n_skip, n_out, X, V, R, 
 SLICE_SECONDS = 0.1
 
 
+_DEFERRED = (signal.SIGINT, signal.SIGTERM)
+
+
+@contextlib.contextmanager
+def deferred_interrupts():
+    """Within the block (a compiled call), SIGINT and SIGTERM are held and delivered when it
+    ends: a signal that arrived while numba was unboxing a model's compiled functions would
+    otherwise surface as a TypeError from numba's dispatcher instead of a clean stop. Compiled
+    code cannot be interrupted anyway, so no responsiveness is lost. Main thread only."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    got = []
+    old = {}
+    for s in _DEFERRED:
+        h = signal.getsignal(s)
+        if callable(h):  # a Python handler (KeyboardInterrupt, the CLI's SIGTERM): hold it
+            old[s] = h
+            signal.signal(s, lambda signum, frame: got.append(signum))
+    try:
+        yield
+    finally:
+        for s, h in old.items():
+            signal.signal(s, h)
+        for s in dict.fromkeys(got):
+            signal.raise_signal(s)
+
+
 class Slicer:
     """Sizes of the slices of a long run (forcing periods per trajectory and compiled call):
     each slice is sized from the measured speed of the previous one so that a call takes about
@@ -53,7 +83,8 @@ class Slicer:
     def run(self, call):
         """``call(size)`` once, timed; adapts the next size. Returns what ``call`` returns."""
         t0 = time.perf_counter()
-        res = call(self.size)
+        with deferred_interrupts():
+            res = call(self.size)
         dt = time.perf_counter() - t0
         grow = 4.0 if dt <= 0.0 else min(4.0, SLICE_SECONDS / dt)
         self.size = max(self.minimum, int(self.size * grow))

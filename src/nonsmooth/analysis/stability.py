@@ -402,7 +402,7 @@ def lambda1_points(P, solver, states, periods: int, *, blocks: int = 10, workers
     re-classified for the generic kernel, mode -1), ``periods`` periods each after
     max(20, periods // 4) periods of alignment, one tangent vector (all local cores).
     Returns (lambda1, stderr, status) arrays."""
-    from ..sweep import threads
+    from ..sweep import deferred_interrupts, threads
     setup = TangentSetup(solver)
     P = np.array(np.atleast_2d(P), dtype=np.float64, order="C")  # writable, contiguous
     S = np.array(states, dtype=np.float64, copy=True).reshape(P.shape[0], -1)
@@ -411,7 +411,7 @@ def lambda1_points(P, solver, states, periods: int, *, blocks: int = 10, workers
         S[:, ST_H] = 0.0
     logs = np.zeros((P.shape[0], periods))
     status = np.zeros(P.shape[0], np.int64)
-    with threads(workers):
+    with threads(workers), deferred_interrupts():
         _lambda1_many(setup.fns, P, setup.opts, S, max(20, periods // 4), periods, setup.N,
                       setup.cmi, logs, status)
     om = P[:, solver.model.index[solver.model.omega]]
@@ -450,7 +450,7 @@ def floquet_lambda1_points(P, solver, states, period, *, workers=None):
     ``states`` on the orbit at a period boundary): the leading Floquet multiplier of the
     p-fold map, from one pass of the tangent kernel over p periods (``_active`` coordinates:
     memory slots the map does not depend on are left out). Returns (lambda1, status)."""
-    from ..sweep import threads
+    from ..sweep import deferred_interrupts, threads
     setup = TangentSetup(solver)
     P = np.array(np.atleast_2d(P), dtype=np.float64, order="C")
     S = np.array(states, dtype=np.float64, copy=True).reshape(P.shape[0], -1)
@@ -461,7 +461,7 @@ def floquet_lambda1_points(P, solver, states, period, *, workers=None):
     n = P.shape[0]
     mono = np.zeros((n, setup.N, setup.N))
     status = np.zeros(n, np.int64)
-    with threads(workers):
+    with threads(workers), deferred_interrupts():
         _monodromy_many(setup.fns, P, setup.opts, S, k, setup.N, setup.cmi, mono, status)
     lam = np.full(n, np.nan)
     om = P[:, solver.model.index[solver.model.omega]]

@@ -39,7 +39,8 @@ class _Pace:
         nb.set_parallel_chunksize(max(1, min(8, items // (8 * nb.get_num_threads()))))
         t0 = time.perf_counter()
         try:
-            done = call()
+            with sweep.deferred_interrupts():
+                done = call()
         finally:
             nb.set_parallel_chunksize(old)
         dt = time.perf_counter() - t0
