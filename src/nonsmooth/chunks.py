@@ -10,7 +10,8 @@ each finishes, to a chunk store on disk; the final result is assembled from the 
   of workers, so every engine gives the same bits.
 * **Store** (:class:`ChunkStore`): a directory with ``manifest.json`` (the analysis and the
   fingerprint of its inputs, including the package version and the chunk layout) and one
-  ``.npz`` file (numpy's format) per finished chunk, each written to a temporary name and renamed, so that a
+  ``.npz`` file (numpy's format) per finished chunk, each written to a temporary name and
+  renamed (``io.write_file``), so that a
   chunk file is complete or absent: a SIGKILL loses at most the chunks in flight. Opening a
   store of a different run is refused with one line; running the same plan again computes
   only the chunks that are missing, and the resumed result is bit-identical to an
@@ -152,11 +153,7 @@ class ChunkStore:
                                      f"afresh")
             old = None  # nothing finished there: nothing to lose
         if old is None:
-            try:
-                _atomic_write(mfile, json.dumps(manifest, indent=1, sort_keys=True).encode())
-            except OSError as exc:
-                raise OutputError(f"store: cannot write {str(self.path)!r}: "
-                                  f"{exc.strerror or exc}") from None
+            _atomic_write(mfile, json.dumps(manifest, indent=1, sort_keys=True).encode())
 
     def chunk_file(self, i: int) -> Path:
         return self.path / f"chunk-{i:06d}.npz"
@@ -170,11 +167,7 @@ class ChunkStore:
         return {i for i in out if 0 <= i < self.plan.n_chunks}
 
     def write(self, i: int, result: dict) -> None:
-        try:
-            _atomic_write(self.chunk_file(i), _to_bytes(result))
-        except OSError as exc:
-            raise OutputError(f"store: cannot write chunk {i} to {str(self.path)!r}: "
-                              f"{exc.strerror or exc}") from None
+        _atomic_write(self.chunk_file(i), _to_bytes(result))
 
     def read(self, i: int) -> dict:
         try:
@@ -228,17 +221,9 @@ def _show(v) -> str:
 
 
 def _atomic_write(path: Path, data: bytes) -> None:
-    tmp = path.with_name(f".{path.name}.{uuid.uuid4().hex[:8]}.part")
-    try:
-        with open(tmp, "wb") as f:
-            f.write(data)
-            f.flush()
-            os.fsync(f.fileno())
-        os.replace(tmp, path)
-    except BaseException:
-        with contextlib.suppress(OSError):
-            tmp.unlink()
-        raise
+    """A store file, complete or absent (``io.write_file``, not listed as a result file)."""
+    from .io import write_file
+    write_file(path, data, "store", record=False)
 
 
 def _to_bytes(result: dict) -> bytes:

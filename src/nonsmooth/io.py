@@ -107,12 +107,13 @@ def written_files() -> list[Path]:
 
 
 @contextlib.contextmanager
-def atomic_path(path, what: str = "output"):
+def atomic_path(path, what: str = "output", record: bool = True):
     """Yield a temporary path in the folder of ``path`` to write the whole file to; when the
     block completes the file is renamed onto ``path`` (``os.replace``: readers, even one that
     holds the old file open, see the old file or the new one, never a partial one). On any
     failure or interruption the temporary file is removed and ``path`` is untouched; an OSError
-    becomes a one-line OutputError naming ``what`` and the path."""
+    becomes a one-line OutputError naming ``what`` and the path. ``record``: list the file in
+    :func:`written_files` (not for internal files such as chunk stores)."""
     p = check_writable(path, what)
     tmp = p.with_name(f".{p.name}.{uuid.uuid4().hex[:8]}.part")
     try:
@@ -128,16 +129,17 @@ def atomic_path(path, what: str = "output"):
             raise OutputError(f"{what}: cannot write {str(p)!r}: "
                               f"{exc.strerror or exc}; {_previous(p)}") from None
         raise
-    _written.append(p)
+    if record:
+        _written.append(p)
 
 
 def _previous(p: Path) -> str:
     return "the previous file is untouched" if p.exists() else "nothing written"
 
 
-def write_file(path, data: str | bytes, what: str = "output") -> Path:
+def write_file(path, data: str | bytes, what: str = "output", record: bool = True) -> Path:
     """Write ``data`` (text as UTF-8, or bytes) to ``path`` atomically (:func:`atomic_path`)."""
-    with atomic_path(path, what) as tmp:
+    with atomic_path(path, what, record) as tmp:
         tmp.write_bytes(data.encode("utf-8") if isinstance(data, str) else data)
     return Path(path)
 

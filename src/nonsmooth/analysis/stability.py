@@ -374,6 +374,13 @@ def _active(M, n):
 
 
 # ---- lambda1 of many points (sweeps) ----------------------------------------------------------
+@nb.njit(cache=True)
+def _period_outputs(m):
+    """The kernel's per-period output buffers (X, V, R, M, X_max, X_min) of ``m`` periods."""
+    return (np.empty(m), np.empty(m), np.empty(m, np.int8), np.empty(m, np.uint8),
+            np.empty(m), np.empty(m))
+
+
 @nb.njit(cache=True, parallel=True)
 def _lambda1_many(fns, P, opts, states, align, periods, N, cmi, logs, status):
     """One tangent vector per point over ``align`` + ``periods`` periods (normalised each
@@ -384,12 +391,7 @@ def _lambda1_many(fns, P, opts, states, align, periods, N, cmi, logs, status):
         Y[0, 0] = 1.0
         Y[1, 0] = 1.0
         L = np.empty((periods, 1))
-        X = np.empty(periods)
-        V = np.empty(periods)
-        R = np.empty(periods, np.int8)
-        M = np.empty(periods, np.uint8)
-        Xa = np.empty(periods)
-        Xb = np.empty(periods)
+        X, V, R, M, Xa, Xb = _period_outputs(periods)
         status[i] = advance_tangent(fns, P[i], opts, states[i], 1, align, periods, X, V, R, M,
                                     Xa, Xb, Y, L, cmi, 1)
         for k in range(periods):
@@ -432,12 +434,7 @@ def _monodromy_many(fns, P, opts, states, k, N, cmi, mono, status):
     for i in nb.prange(P.shape[0]):
         Y = np.eye(N)
         m = k[i]
-        X = np.empty(m)
-        V = np.empty(m)
-        R = np.empty(m, np.int8)
-        M = np.empty(m, np.uint8)
-        Xa = np.empty(m)
-        Xb = np.empty(m)
+        X, V, R, M, Xa, Xb = _period_outputs(m)
         status[i] = advance_tangent(fns, P[i], opts, states[i], 1, 0, m, X, V, R, M, Xa, Xb,
                                     Y, np.zeros((0, 0)), cmi, 0)
         for a in range(N):
