@@ -40,6 +40,8 @@ VERDICTS = {0: "unknown", PERIODIC: "periodic", QUASI_PERIODIC: "quasi-periodic"
 N_SIGMA = 3.0
 #: |mu| within this of 1 is neutral (e.g. the time shift of an unforced limit cycle).
 NEUTRAL = 1e-6
+#: A converged orbit integrated again (other steps) must close to this (relative to 1 + |z|).
+CONFIRM_TOL = 1e-6
 ALIGN = 100  # periods of the transient that also carry the tangent vectors (alignment)
 _SLICE = 2000  # periods per kernel call (progress and Ctrl-C between calls)
 
@@ -214,7 +216,10 @@ def periodic_orbit(params, *, k: int = 1, x0: float = 0.0, v0: float = 0.0,
     (interior extrema), ``contact_fraction`` (fraction of the orbit's samples in the model's
     contact modes), the orbit itself (``X``, ``V``, ``mode`` over ``t``, one period k T at
     ``samples_per_period`` per period), and attrs ``status`` ("converged", "max_iter",
-    "diverged", "integration failed: ...", "singular"), ``iterations`` and ``residual``.
+    "diverged", "integration failed: ...", "singular", "not confirmed: ..."), ``iterations``,
+    ``residual`` and ``confirmation_residual``: a converged orbit is integrated once more,
+    sampled ``samples_per_period`` times a period (so with other steps than Newton's), and is
+    reported converged only if it closes on itself to ``CONFIRM_TOL`` (1 + |z|).
     Bad input raises one-line ParameterErrors; a failed search is a status, not an error."""
     params, solver, p, opts, state = start_trajectory(params, x0, v0, method, rtol, atol,
                                                       "eq13")
@@ -303,6 +308,14 @@ def periodic_orbit(params, *, k: int = 1, x0: float = 0.0, v0: float = 0.0,
     Xs, Vs, R, Mk, Xmax, Xmin = bufs
     if code != st.OK:
         Xs[:] = np.nan
+    # confirmation: the orbit integrated again, sampled samples_per_period times a period (other
+    # steps than Newton's), must close on itself
+    confirm = (float(np.linalg.norm(setup.z_of(s_orbit) - setup.z_of(start)))
+               if code == st.OK else math.inf)
+    if converged and not confirm <= CONFIRM_TOL * (1.0 + float(np.linalg.norm(z))):
+        status = (f"not confirmed: integrated again at {spp} samples per period, the orbit "
+                  f"misses its start by {confirm:.3g}")
+        converged = False
     X = np.concatenate([[start[0]], Xs])
     V = np.concatenate([[start[1]], Vs])
     R = np.concatenate([[int(start[ST_MODE])], R]).astype(np.int8)
@@ -354,6 +367,7 @@ def periodic_orbit(params, *, k: int = 1, x0: float = 0.0, v0: float = 0.0,
         attrs=provenance_attrs(params, solver, analysis="periodic_orbit", k=k, x0=float(x0),
                                v0=float(v0), transient=transient, tol=tol,
                                status=status, iterations=it, residual=res,
+                               confirmation_residual=confirm,
                                converged=int(converged),
                                verdict=("stable" if stable else "neutral" if neutral
                                         else "unstable") if converged else "not found",

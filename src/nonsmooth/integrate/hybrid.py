@@ -17,6 +17,13 @@ Design summary
   retaken exactly up to it, and ``transition`` (reset, new mode) is applied there; no FSAL
   across a switch. A guard with g <= 0 and g' < 0 at a step start triggers its transition at
   once; more than ``ZENO_MAX`` consecutive transitions each < ``ZENO_DT`` T apart -> ZENO.
+* A guard with forcing terms (G[k, n+1], G[k, n+2]) is not a cubic along a step, and a step can
+  be long (a stick phase has a zero error estimate, so its RKF45 steps grow to a whole output
+  interval): its exit test is certified. A step whose Hermite of (g, g') does not clear zero by
+  its error bound (derivative bounds, ``pwlinear.HERM_ERR`` / a Bernstein test of the pointwise
+  bound) is scanned piece by piece (``pwlinear.classify`` on -g, halving undecided pieces), and
+  a located crossing is checked to be the first. So the answer does not depend on where outputs
+  are taken (issue 20).
 * ``opts[OPT_CLOSED_FORM] == 1`` and n == 2: modes that ``linear`` declares
   X'' + c X' + k X = F cos(omega t) + b (k > 0) are propagated in closed form
   (:mod:`.pwlinear`) in pieces of at most THETA = 0.7 rad of their fastest oscillation; the
@@ -62,8 +69,9 @@ from .contract import (  # noqa: E402
     ST_VA,
     ST_X,
 )
-from .pwlinear import (MC_A, MC_K, MC_LMAX, N_MC, accel, eval_state, herm_coeffs,  # noqa: E402
-                       hom_part, mode_coeffs, propagator)
+from .pwlinear import (BD_D2, BD_D3, BD_D4, BD_R, EXCLUDED, HERM_ERR, MC_A,  # noqa: E402
+                       MC_K, MC_LMAX, N_BD, N_MC, accel, classify, energy_norm, eval_state, functional_bounds,
+                       herm_coeffs, hom_part, jerk, mode_coeffs, propagator)
 from .record import record_interval  # noqa: E402
 from .roots import illinois_point, illinois_update, quad_roots01  # noqa: E402
 from .rkstep import (_A, _B, _C, _E, _FM, _NS, _control, _cubic, _shrink,  # noqa: E402
@@ -199,19 +207,198 @@ def _g_at(cf, s, G, k, n, q0, q1, q2, q3, C, S, om, hs, MC, mode, y0, z0):
     return _cubic(q0, q1, q2, q3, s) + G[k, n] + G[k, n + 1] * Cs + G[k, n + 2] * Ss
 
 
+# ---- certified exit test ----------------------------------------------------------------------
+SCAN_DEPTH = 30  # halvings of a step in the certified exit test (down to 1e-9 of the step)
+
+
+@nb.njit(cache=True, inline="always", fastmath=_FM)
+def _g_full(cf, s, G, k, n, q0, q1, q2, q3, C, S, om, hs, MC, mode, y0, z0, F):
+    """Guard k and its first two time derivatives (g, g', g'') at the fraction s of the step:
+    on the exact closed form (cf; F = the mode's forcing amplitude, for the jerk) or on the
+    cubic Hermite of the state (projection q0..q3), with the exact forcing terms of the guard."""
+    if cf:
+        X, V, A, y, z, Cs, Ss = eval_state(MC, mode, om, y0, z0, C, S, s * hs)
+        Jk = jerk(MC, mode, om, F, V, A, Ss)
+        g = G[k, 0] * X + G[k, 1] * V
+        d = G[k, 0] * V + G[k, 1] * A
+        dd = G[k, 0] * A + G[k, 1] * Jk
+    else:
+        cw, sw = cos_sin_small(om * s * hs)
+        Cs = C * cw - S * sw
+        Ss = S * cw + C * sw
+        g = _cubic(q0, q1, q2, q3, s)
+        d = (q1 + s * (2.0 * q2 + 3.0 * q3 * s)) / hs
+        dd = (2.0 * q2 + 6.0 * q3 * s) / (hs * hs)
+    a = G[k, n + 1]
+    b = G[k, n + 2]
+    g += G[k, n] + a * Cs + b * Ss
+    d += om * (b * Cs - a * Ss)
+    dd -= om * om * (a * Cs + b * Ss)
+    return g, d, dd
+
+
 @nb.njit(cache=True)
-def _mode_class(linear, closed, mode, pp, lin, MC, mcs, om):
-    """_MC_CLOSED / _MC_RK / _MC_RESONANT for ``mode``, filling the table row lazily."""
+def _guard_bounds(cf, G, k, n, q2, q3, om, hs, MC, mode, y0, z0, BD):
+    """(M2, M3, M4): bounds of |g''|, |g'''|, |g''''| of guard k over the whole step. On a
+    closed-form piece: the energy-norm bounds of the homogeneous part plus om^n times the
+    harmonic amplitudes (``pwlinear.functional_bounds``, into the scratch ``BD``); on an RKF45
+    step: the derivatives of the state's cubic plus om^n times the amplitude of the guard's
+    forcing terms."""
+    om2 = om * om
+    Rg = math.hypot(G[k, n + 1], G[k, n + 2])
+    if cf:
+        functional_bounds(MC[mode], om, G[k, 0], G[k, 1], BD)
+        En = energy_norm(MC, mode, y0, z0)
+        R = BD[BD_R] + Rg
+        return (BD[BD_D2] * En + om2 * R, BD[BD_D3] * En + om2 * om * R,
+                BD[BD_D4] * En + om2 * om2 * R)
+    h2 = hs * hs
+    return (max(abs(2.0 * q2), abs(2.0 * q2 + 6.0 * q3)) / h2 + om2 * Rg,
+            6.0 * abs(q3) / (h2 * hs) + om2 * om * Rg, om2 * om2 * Rg)
+
+
+@nb.njit(cache=True, inline="always", fastmath=_FM)
+def _g_dd(cf, G, k, n, u, f, C, S, om, MC, mode, F, cdd, hs):
+    """g'' of guard k at a step end with state u, derivative f and forcing phase (C, S) (on an
+    RKF45 step ``cdd`` is the second derivative of the state cubic's projection there, per
+    fraction squared)."""
+    if cf:
+        dd = G[k, 0] * f[1] + G[k, 1] * jerk(MC, mode, om, F, u[1], f[1], S)
+    else:
+        dd = cdd / (hs * hs)
+    return dd - om * om * (G[k, n + 1] * C + G[k, n + 2] * S)
+
+
+@nb.njit(cache=True, inline="always", fastmath=_FM)
+def _herm_clear(g0, d0, g1, d1, L, M4):
+    """True when g >= 0 on [0, L] is certified from its ends alone: the cubic Hermite H of
+    (g, g') less its pointwise error bound M4 L^4 u^2 (1 - u)^2 / 24 (u = s / L, M4 >= |g''''|)
+    is a quartic in u whose Bernstein coefficients are all >= 0."""
+    b1, b2, b3 = herm_coeffs(g0, d0, g1, d1, L)
+    c = M4 * (L * L) * (L * L) / 24.0
+    a2 = b2 - c
+    a3 = b3 + 2.0 * c
+    return (g0 >= 0.0 and g1 >= 0.0 and g0 + 0.25 * b1 >= 0.0
+            and g0 + 0.5 * b1 + a2 / 6.0 >= 0.0
+            and g0 + 0.75 * b1 + 0.5 * a2 + 0.25 * a3 >= 0.0)
+
+
+@nb.njit(cache=True)
+def _first_negative(cf, s_end, ga, da, dda, gb, db, ddb, G, k, n, q0, q1, q2, q3, C, S, om, hs,
+                    MC, mode, y0, z0, F, M2, M3, M4, stack):
+    """The first point found in (0, s_end] (fractions of the step) where guard k < 0, as
+    (s, g(s)); (2.0, 0.0) when g >= 0 on [0, s_end] is certified. (ga, da, dda) and
+    (gb, db, ddb): g, g', g'' at 0 and at s_end.
+
+    Pieces are taken left to right; ``pwlinear.classify`` on -g with the derivative bounds
+    M2..M4 excludes a piece rigorously, an undecided piece is halved (at most SCAN_DEPTH
+    times; a piece still undecided then is tested at its midpoint). So a guard cannot dip below
+    zero and come back inside a step unseen, however long the step: the RKF45 steps of a mode
+    with a zero error estimate (a stick phase) grow to a whole output interval, and a guard
+    with forcing terms can change sign twice inside one."""
+    a = 0.0
+    b = s_end
+    depth = 0
+    top = 0
+    ga = max(ga, 0.0)  # round-off after the switch into this mode
+    while True:
+        if gb < 0.0:
+            return b, gb
+        L = (b - a) * hs
+        if not _herm_clear(ga, da, gb, db, L, M4) and classify(
+                -ga, -da, -dda, -gb, -db, L, M2, M3, M4) != EXCLUDED:
+            if depth < SCAN_DEPTH:
+                stack[top, 0] = b
+                stack[top, 1] = gb
+                stack[top, 2] = db
+                stack[top, 3] = ddb
+                stack[top, 4] = depth + 1
+                top += 1
+                b = 0.5 * (a + b)
+                depth += 1
+                gb, db, ddb = _g_full(cf, b, G, k, n, q0, q1, q2, q3, C, S, om, hs, MC, mode, y0,
+                                      z0, F)
+                continue
+            sm = 0.5 * (a + b)
+            gm, _, _ = _g_full(cf, sm, G, k, n, q0, q1, q2, q3, C, S, om, hs, MC, mode, y0, z0,
+                               F)
+            if gm < 0.0:
+                return sm, gm
+        if top == 0:
+            return 2.0, 0.0
+        top -= 1
+        a = b
+        ga = gb
+        da = db
+        dda = ddb
+        b = stack[top, 0]
+        gb = stack[top, 1]
+        db = stack[top, 2]
+        ddb = stack[top, 3]
+        depth = int(stack[top, 4])
+
+
+@nb.njit(cache=True, inline="always", fastmath=_FM)
+def _locate(cf, lo, hi, glo, ghi, G, k, n, q0, q1, q2, q3, C, S, om, hs, MC, mode, y0, z0):
+    """Illinois on the bracket [lo, hi] (fractions of the step; g(lo) >= 0 > g(hi)) down to
+    S_TOL; returns the final (lo, hi)."""
+    side = 0
+    for _ in range(200):
+        if hi - lo <= S_TOL:
+            break
+        sm = illinois_point(lo, hi, glo, ghi)
+        gm = _g_at(cf, sm, G, k, n, q0, q1, q2, q3, C, S, om, hs, MC, mode, y0, z0)
+        lo, hi, glo, ghi, side = illinois_update(lo, hi, glo, ghi, side, sm, gm)
+    return lo, hi
+
+@nb.njit(cache=True)
+def _mode_class(linear, closed, mode, pp, lin, MC, mcs, om, MF):
+    """_MC_CLOSED / _MC_RK / _MC_RESONANT for ``mode``, filling the table row (and the forcing
+    amplitude ``MF[mode]``) lazily."""
     if not closed:
         return _MC_RK
     if mcs[mode] == _MC_UNKNOWN:
         mcs[mode] = _MC_RK
         if linear(mode, pp, lin) == 1 and lin[0] > 0.0:
+            MF[mode] = lin[3]
             if mode_coeffs(lin[0], lin[1], lin[2], lin[3], om, THETA, MC[mode]):
                 mcs[mode] = _MC_CLOSED
             else:
                 mcs[mode] = _MC_RESONANT
     return mcs[mode]
+
+
+@nb.njit(cache=True)
+def _scan_step(cf, g0, d0, g1, d1, u, f0, u1, f1, C, S, C1, S1, G, k, n, q0, q1, q2, q3, om, hs,
+               MC, mode, y0, z0, F, stack, BD):
+    """Certified exit test of guard k over a whole step that the quick test passed: the first
+    point found where g < 0, as (s, g(s)), or (2.0, 0.0) (``_first_negative``)."""
+    M2, M3, M4 = _guard_bounds(cf, G, k, n, q2, q3, om, hs, MC, mode, y0, z0, BD)
+    dd0 = _g_dd(cf, G, k, n, u, f0, C, S, om, MC, mode, F, 2.0 * q2, hs)
+    dd1 = _g_dd(cf, G, k, n, u1, f1, C1, S1, om, MC, mode, F, 2.0 * q2 + 6.0 * q3, hs)
+    return _first_negative(cf, 1.0, g0, d0, dd0, g1, d1, dd1, G, k, n, q0, q1, q2, q3, C, S, om,
+                           hs, MC, mode, y0, z0, F, M2, M3, M4, stack)
+
+
+@nb.njit(cache=True)
+def _first_crossing(cf, lo, hi, g0, d0, u, f0, C, S, G, k, n, q0, q1, q2, q3, om, hs, MC,
+                    mode, y0, z0, F, stack, BD):
+    """The located crossing [lo, hi] of guard k must be its first: g >= 0 on [0, lo] is
+    certified, else the crossing is located again before the first negative point found.
+    Returns the final (lo, hi)."""
+    M2, M3, M4 = _guard_bounds(cf, G, k, n, q2, q3, om, hs, MC, mode, y0, z0, BD)
+    dd0 = _g_dd(cf, G, k, n, u, f0, C, S, om, MC, mode, F, 2.0 * q2, hs)
+    for _ in range(8):
+        if not lo > 0.0:
+            break
+        gl, dl, ddl = _g_full(cf, lo, G, k, n, q0, q1, q2, q3, C, S, om, hs, MC, mode, y0, z0, F)
+        sf, gf = _first_negative(cf, lo, g0, d0, dd0, gl, dl, ddl, G, k, n, q0, q1, q2, q3, C, S,
+                                 om, hs, MC, mode, y0, z0, F, M2, M3, M4, stack)
+        if sf > 1.0:
+            break
+        lo, hi = _locate(cf, 0.0, sf, g0, gf, G, k, n, q0, q1, q2, q3, C, S, om, hs, MC, mode,
+                         y0, z0)
+    return lo, hi
 
 
 @nb.njit(cache=True, inline="always")
@@ -479,7 +666,10 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
     G = np.zeros((MAX_GUARDS, n + 3))
     MC = np.zeros((MAX_MODES, N_MC))
     mcs = np.zeros(MAX_MODES, np.int64)
+    MF = np.zeros(MAX_MODES)
     lin = np.zeros(4)
+    BD = np.zeros(N_BD)
+    stack = np.zeros((SCAN_DEPTH + 1, 5))
     # tangent work arrays (empty without a tangent)
     nt = n if tan else 0
     mt = Y.shape[1]
@@ -527,7 +717,7 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
         _store(state, u, n, mem, nmem, mode, h)
         return st.EVENT_FAILED
     ng = min(max(guards(mode, pp, mem, G), 0), MAX_GUARDS)
-    cls = _mode_class(linear, closed, mode, pp, lin, MC, mcs, om)
+    cls = _mode_class(linear, closed, mode, pp, lin, MC, mcs, om, MF)
     if cls == _MC_RESONANT:
         _store(state, u, n, mem, nmem, mode, h)
         return st.RESONANCE
@@ -621,6 +811,24 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
                             if gq < 0.0:
                                 hi = q
                                 ghi = gq
+                    # certified for guards with forcing terms, whose values along a step are
+                    # not a cubic: the Hermite of (g, g') is then within HERM_ERR M4 hs^4 of g
+                    # and a step it does not clear is scanned (``_scan_step``). Guards without
+                    # forcing terms are cubics along an RKF45 step (the test above is exact on
+                    # the interpolant); on a closed-form piece (<= THETA rad) the Hermite test
+                    # stands, as before
+                    cert = G[k, n + 1] != 0.0 or G[k, n + 2] != 0.0
+                    if cert and hi > 1.0:
+                        hm = min(g0, g1)
+                        for q in (r1, r2):
+                            if 0.0 < q < 1.0:
+                                hm = min(hm, g0 + q * (b1 + q * (b2 + q * b3)))
+                        M4 = _guard_bounds(cf, G, k, n, q2, q3, om, hs, MC, mode, y0, z0, BD)[2]
+                        if not (hm > HERM_ERR * M4 * ((hs * hs) * (hs * hs)) or _herm_clear(g0, d0, g1, d1, hs,
+                                                                         M4)):
+                            hi, ghi = _scan_step(cf, g0, d0, g1, d1, u, f0, u1, f1, C, S, C1, S1,
+                                                 G, k, n, q0, q1, q2, q3, om, hs, MC, mode, y0,
+                                                 z0, MF[mode], stack, BD)
                     if hi > 1.0:
                         continue
                     if hi > s_best:
@@ -640,6 +848,10 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
                         gm = _g_at(cf, sm, G, k, n, q0, q1, q2, q3, C, S, om, hs, MC, mode,
                                    y0, z0)
                         lo, hi, glo, ghi, side = illinois_update(lo, hi, glo, ghi, side, sm, gm)
+                    if cert and lo > 0.0:  # the first crossing, not a later one
+                        lo, hi = _first_crossing(cf, lo, hi, g0, d0, u, f0, C, S, G, k, n, q0,
+                                                 q1, q2, q3, om, hs, MC, mode, y0, z0, MF[mode],
+                                                 stack, BD)
                     if hi - lo > S_TOL:
                         code = st.EVENT_FAILED
                         break
@@ -713,7 +925,7 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
                 mode = new_mode
                 mask |= 1 << mode
                 ng = min(max(guards(mode, pp, mem, G), 0), MAX_GUARDS)
-                cls = _mode_class(linear, closed, mode, pp, lin, MC, mcs, om)
+                cls = _mode_class(linear, closed, mode, pp, lin, MC, mcs, om, MF)
                 if cls == _MC_RESONANT:
                     code = st.RESONANCE
                     break
