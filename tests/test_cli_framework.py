@@ -12,6 +12,8 @@ import xarray as xr
 
 from nonsmooth import io
 
+from cli_helpers import SAFETY_S, popen
+
 # Runs the CLI with one step of the work replaced by a stand-in that reports "ready" on stdout
 # and waits, so that a signal arrives in the middle of it: the trajectory ("simulate") or the
 # figure ("plot", after the netCDF file was written).
@@ -21,7 +23,8 @@ import nonsmooth.simulate, nonsmooth.plot.time_response
 
 def wait(*args, **kwargs):
     print("ready", flush=True)
-    time.sleep(120)
+    while True:
+        time.sleep(1)
 
 if "{stage}" == "simulate":
     sys.modules["nonsmooth.simulate"].simulate = wait
@@ -33,13 +36,12 @@ main({argv!r})
 
 
 def _interrupt(tmp_path, stage, sig, argv):
-    proc = subprocess.Popen([sys.executable, "-c", DRIVER.format(stage=stage, argv=argv)],
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
-                            cwd=tmp_path)
+    proc = popen([sys.executable, "-c", DRIVER.format(stage=stage, argv=argv)],
+                 stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, cwd=tmp_path)
     try:
         assert proc.stdout.readline().strip() == "ready"
         proc.send_signal(sig)
-        out, err = proc.communicate(timeout=60)
+        out, err = proc.communicate(timeout=SAFETY_S)
     finally:
         proc.kill()
     return proc.returncode, out, err

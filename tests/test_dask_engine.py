@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 import nonsmooth as ns
-from cli_helpers import one_line, run_cli
+from cli_helpers import SAFETY_S, one_line, run_cli
 
 distributed = pytest.importorskip("distributed")
 
@@ -56,7 +56,7 @@ def test_a_worker_killed_mid_run_has_its_chunks_retried(client, tmp_path):
     killed = []
 
     def killer():
-        t_end = time.monotonic() + 120
+        t_end = time.monotonic() + SAFETY_S
         while time.monotonic() < t_end:
             if len(list(store.glob("chunk-*.npz"))) >= 3:
                 os.kill(pids[0], signal.SIGKILL)
@@ -72,13 +72,12 @@ def test_a_worker_killed_mid_run_has_its_chunks_retried(client, tmp_path):
     assert len(list(store.glob("chunk-*.npz"))) == 30
 
 
-def test_an_unreachable_scheduler_is_one_line_within_seconds(capsys, tmp_path):
+def test_an_unreachable_scheduler_is_one_line(capsys, tmp_path):
     out = tmp_path / "m.nc"
-    t0 = time.monotonic()
     code, _, err = run_cli(["map", "--method", "exact", "--x", "omega", "0.8", "1.0", "3",
                             "--y", "F0", "0.2", "0.3", "2", "--dask", "tcp://127.0.0.1:1",
                             "-o", str(out)], capsys)
-    assert code == 2 and time.monotonic() - t0 < 15
+    assert code == 2
     one_line(err, "dask: cannot reach the scheduler at tcp://127.0.0.1:1")
     assert not out.exists() and not (tmp_path / "m.nc.chunks").exists()
 

@@ -6,7 +6,6 @@ import os
 import signal
 import subprocess
 import sys
-import time
 
 import numpy as np
 import pytest
@@ -16,6 +15,8 @@ import nonsmooth.sweep as sweep
 from nonsmooth.analysis.bifurcation import bifurcation_diagram
 from nonsmooth.analysis.eta_study import eta_study
 from nonsmooth.analysis.poincare import poincare
+
+from cli_helpers import SAFETY_S, popen, wait_until
 
 
 def _cli(*args, cwd=None, env=None):
@@ -27,27 +28,21 @@ def _cli(*args, cwd=None, env=None):
     ["simulate", "--transient", "1000000000", "--periods", "1"],
     ["bifurcation", "--steps", "40", "--transient", "1000000000"],
 ])
-def test_ctrl_c_stops_a_single_long_computation_within_a_second(argv, tmp_path):
-    # warm the on-disk cache in this process so that the child does not compile
-    ns.simulate(ns.preset("table1"), periods=1, transient=1, samples_per_period=2)
-    bifurcation_diagram(ns.preset("table3"), "omega", [0.9, 0.91], transient=1, record=1)
+def test_ctrl_c_stops_a_single_long_computation(argv, tmp_path):
+    """Ctrl-C inside one compiled trajectory: exit 130, the one line, the old file untouched
+    (how fast it stops is measured by ``benchmarks/bench_interrupt.py``)."""
     out = tmp_path / "a.nc"
     out.write_bytes(b"previous result")
     err = tmp_path / "err.txt"
     env = dict(os.environ, NONSMOOTH_PROGRESS="1")
     with open(err, "w") as fe:
-        proc = subprocess.Popen([sys.executable, "-m", "nonsmooth.cli", *argv, "-o", str(out)],
-                                stdout=subprocess.DEVNULL, stderr=fe, env=env, cwd=tmp_path)
-        t_end = time.monotonic() + 120
-        while time.monotonic() < t_end and "% of" not in err.read_text():  # progress line
-            time.sleep(0.2)
-        assert proc.poll() is None, err.read_text()
-        t0 = time.monotonic()
+        proc = popen([sys.executable, "-m", "nonsmooth.cli", *argv, "-o", str(out)],
+                     stdout=subprocess.DEVNULL, stderr=fe, env=env, cwd=tmp_path)
+        wait_until(proc, lambda: "% of" in err.read_text(), "a progress line")
         proc.send_signal(signal.SIGINT)
-        code = proc.wait(timeout=30)
-        dt = time.monotonic() - t0
+        code = proc.wait(timeout=SAFETY_S)
     text = err.read_text()
-    assert dt < 3.0 and code != 0
+    assert code == 130, text
     assert "Traceback" not in text
     assert text.strip().splitlines()[-1].startswith("interrupted")
     assert out.read_bytes() == b"previous result"

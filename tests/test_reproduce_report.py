@@ -11,7 +11,6 @@ import re
 import signal
 import subprocess
 import sys
-import time
 
 import numpy as np
 import pytest
@@ -22,6 +21,8 @@ from nonsmooth.cli import main
 from nonsmooth.reproduction import AGREES, DIFFERS, FIGURES, reproduce
 from nonsmooth.reproduction.core import FigureRecord, figure
 from nonsmooth.reproduction.figures.fig09_11_bifurcation import point_in_diagram
+
+from cli_helpers import SAFETY_S, popen, wait_until  # noqa: E402
 
 
 def _check(rec, start):
@@ -196,15 +197,12 @@ def test_interrupt_keeps_finished_figures_and_the_report(tmp_path, monkeypatch):
 
 def test_cli_sigint_keeps_the_finished_figures(tmp_path):
     out = tmp_path / "run"
-    proc = subprocess.Popen([sys.executable, "-m", "nonsmooth.cli", "reproduce", "--quick",
-                             "--only", "fig3,fig4,fig9", "--out", str(out)],
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-    t0 = time.monotonic()
-    while not (out / "report.md").exists() and proc.poll() is None \
-            and time.monotonic() - t0 < 300:
-        time.sleep(0.05)
+    proc = popen([sys.executable, "-m", "nonsmooth.cli", "reproduce", "--quick",
+                  "--only", "fig3,fig4,fig9", "--out", str(out)],
+                 stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    wait_until(proc, lambda: (out / "report.md").exists(), "the first report (fig3 done)")
     proc.send_signal(signal.SIGINT)
-    _, err = proc.communicate(timeout=120)
+    _, err = proc.communicate(timeout=SAFETY_S)
     assert proc.returncode == 130, err
     assert "Traceback" not in err
     md = (out / "report.md").read_text()  # written when fig3 was done, then on the interrupt

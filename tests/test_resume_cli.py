@@ -2,16 +2,16 @@
 then the same command resumes, recomputes nothing finished, and gives the numbers of an
 uninterrupted run; an existing result is never destroyed; a store of another run is refused."""
 
-import os
 import signal
 import subprocess
 import sys
-import time
 
 import numpy as np
 import pytest
 
 import nonsmooth as ns
+
+from cli_helpers import SAFETY_S, popen, wait_until
 
 ARGS = ["map", "--method", "exact", "--x", "omega", "0.8", "1.0", "80", "--y", "F0", "0.15",
         "0.45", "64", "--transient", "300", "--record", "50", "--chunk", "256"]
@@ -28,19 +28,13 @@ def reference():
 def _start(out, extra=()):
     err = out.with_suffix(".err")
     fe = open(err, "w")
-    proc = subprocess.Popen([sys.executable, "-m", "nonsmooth.cli", *ARGS, *extra, "-o", str(out)],
-                            stdout=subprocess.DEVNULL, stderr=fe, cwd=out.parent)
+    proc = popen([sys.executable, "-m", "nonsmooth.cli", *ARGS, *extra, "-o", str(out)],
+                 stdout=subprocess.DEVNULL, stderr=fe, cwd=out.parent)
     return proc, err, fe
 
 
-def _wait_for_chunks(proc, store, n, timeout=240):
-    t_end = time.monotonic() + timeout
-    while time.monotonic() < t_end:
-        if proc.poll() is not None:
-            return
-        if len(list(store.glob("chunk-*.npz"))) >= n:
-            return
-        time.sleep(0.02)
+def _wait_for_chunks(proc, store, n):
+    wait_until(proc, lambda: len(list(store.glob("chunk-*.npz"))) >= n, f"{n} chunk files")
 
 
 def _run(out):
@@ -65,7 +59,7 @@ def test_a_stopped_map_says_what_it_saved_and_resumes_bit_identically(sig, code,
     _wait_for_chunks(proc, store, 3)
     assert proc.poll() is None, err.read_text()
     proc.send_signal(sig)
-    assert proc.wait(timeout=30) == code
+    assert proc.wait(timeout=SAFETY_S) == code
     fe.close()
     text = err.read_text()
     assert "Traceback" not in text
@@ -92,7 +86,7 @@ def test_sigkill_loses_only_chunks_in_flight_and_a_store_of_another_run_is_refus
     _wait_for_chunks(proc, store, 4)
     assert proc.poll() is None, err.read_text()
     proc.kill()
-    proc.wait(timeout=30)
+    proc.wait(timeout=SAFETY_S)
     fe.close()
     saved = sorted(store.glob("chunk-*.npz"))
     assert len(saved) >= 4 and not out.exists()
@@ -128,7 +122,7 @@ def test_a_killed_continuation_sweep_resumes_from_its_last_chunk(tmp_path):
     _wait_for_chunks(proc, store, 2)
     assert proc.poll() is None
     proc.kill()
-    proc.wait(timeout=30)
+    proc.wait(timeout=SAFETY_S)
     n_saved = len(list(store.glob("chunk-*.npz")))
     assert 2 <= n_saved < 32  # 16 chunks per direction
     res = subprocess.run([sys.executable, "-m", "nonsmooth.cli", *args, "-o", str(out)],

@@ -228,15 +228,23 @@ def format_bytes(n: float) -> str:
     return f"{n:.1f} PiB"
 
 
-def check_memory(nbytes: float, field: str, hint: str, fraction: float = 0.8) -> None:
+def check_memory(nbytes: float, field: str, hint: str, fraction: float = 0.8,
+                 size: tuple | None = None) -> None:
     """Refuse, before computing, a request whose arrays (``nbytes`` in all) would not fit in
     ``fraction`` of the available memory: one ParameterError naming ``field``, the size, the
-    memory available and ``hint`` (what to do instead)."""
+    memory available and ``hint`` (what to do instead). ``size = (n, power)``: the request's
+    size as the user typed it, with nbytes growing as n**power; the line then also gives the
+    largest n that fits."""
     from .errors import ParameterError
     avail = available_memory()
     if avail is not None and nbytes > fraction * avail:
+        fits = ""
+        if size is not None:
+            n, power = size
+            largest = int(n * (fraction * avail / nbytes) ** (1.0 / power))
+            fits = f"; at most {field} = {largest:,} fits"
         raise ParameterError(f"{field}: the result would need {format_bytes(nbytes)} of memory, "
-                             f"{format_bytes(avail)} available; {hint}")
+                             f"{format_bytes(avail)} available{fits}; {hint}")
 
 
 def finite_or_nan(x) -> float:

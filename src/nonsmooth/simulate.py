@@ -106,8 +106,12 @@ def simulate(params: Params, *, periods: int, transient: int = 0,
     (the true extremes of X since the previous sample, interior extrema included; at the first
     sample X itself) and the scalars ``max_X``, ``min_X`` (true extremes over the whole
     recorded run) and ``regions_visited`` (bit mask over the run). The run is integrated in
-    time slices; ``progress(done, total)`` (in forcing periods) is called between them.
+    time slices; ``progress`` (None or False: silent; True: a progress bar with a time estimate on
+    a terminal, plain lines elsewhere; or a callable ``progress(done, total)``) (in forcing
+    periods) is called between them.
     """
+    from .sweep import progress_callback
+    progress = progress_callback(progress, "simulate")
     from .io import check_memory, flag_attrs, format_bytes
     from .sweep import run_trajectories
     params, solver, p, opts, state = start_trajectory(params, x0, v0, method, rtol, atol,
@@ -116,9 +120,10 @@ def simulate(params: Params, *, periods: int, transient: int = 0,
     transient = check_int("transient", transient, 0)
     spp = check_int("samples_per_period", samples_per_period, 1)
     n = periods * spp
-    check_memory(_SAMPLE_BYTES * (n + 1.0), "periods",
+    big = ("periods", periods) if periods >= spp else ("samples_per_period", spp)
+    check_memory(_SAMPLE_BYTES * (n + 1.0), big[0],
                  f"record fewer periods or samples per period ({n + 1} samples at "
-                 f"{format_bytes(_SAMPLE_BYTES)} each)")
+                 f"{format_bytes(_SAMPLE_BYTES)} each)", size=(big[1], 1))
     x0, v0 = float(state[0]), float(state[1])
     P = p[None, :]
     total = transient + periods

@@ -182,6 +182,25 @@ def run_trajectories(P, solver: Solver, states, *, per_period: int, n_skip: int,
     return out
 
 
+PROGRESS_DOC = ("``progress``: None or False (default: silent), True (a progress bar with a "
+                "time estimate on a terminal, plain lines elsewhere, for runs longer than 2 s) "
+                "or a callable ``progress(done, total)``")
+
+
+def progress_callback(progress, description: str):
+    """The callable behind a ``progress`` argument of the public API: None or False -> None
+    (silent); True -> a :class:`Progress` bar named ``description``; a callable
+    ``progress(done, total)`` -> itself. Anything else is a one-line ParameterError."""
+    if progress is None or progress is False:
+        return None
+    if progress is True:
+        return Progress(description, enabled=True)
+    if callable(progress):
+        return progress
+    raise ParameterError(f"progress: expected True, False, None or a callable progress(done, "
+                         f"total), got {progress!r}")
+
+
 class Progress:
     """A rich progress bar with ETA that only appears for runs longer than ``delay`` seconds
     and only on a terminal; with NONSMOOTH_PROGRESS=1 and no terminal, plain progress lines.

@@ -146,11 +146,17 @@ def param_rows(params: ParamsBase, param: str, values) -> np.ndarray:
     return rows
 
 
-def check_sweep_memory(n_values: int, n_branches: int, record: int) -> None:
-    """Refuse, before computing, a sweep whose section data would not fit in memory."""
+def check_sweep_memory(n_values: int, n_branches: int, record: int, field: str = "values") -> None:
+    """Refuse, before computing (and before the values are built: the CLI calls it with the
+    typed ``--steps``), a sweep whose section data would not fit in memory; the line names the
+    larger of ``field`` (the number of values) and ``record``, and the largest that fits."""
     from ..io import check_memory
-    check_memory(34.0 * n_values * n_branches * record, "record",
-                 "record fewer section points per value, or sweep fewer values")
+    big = ("record", record) if record >= n_values else (field, n_values)  # the larger factor
+    check_memory(34.0 * n_values * n_branches * record + 8.0 * n_values, big[0],
+                 (f"{n_values:,} values x {n_branches} sweep(s) x {record:,} recorded periods; "
+                  f"sweep fewer values or record fewer periods per value") if record else
+                 f"{n_values:,} values; use fewer values",
+                 size=(big[1], 1))
 
 
 def follow(P, solver: Solver, states, init, transient: int, settle_tol: float, record: int,
@@ -511,7 +517,11 @@ def bifurcation_diagram(params: ParamsBase, param: str, values, *, sweep: str = 
     sweep with the same store again resumes (see ``nonsmooth.chunks``). ``engine``: None (all
     local cores), "local[:N]" (a Dask LocalCluster), a Dask scheduler address or a
     ``dask.distributed.Client``; the numbers do not depend on it.
+    ``progress`` (None or False: silent; True: a progress bar with a time estimate on a terminal,
+    plain lines elsewhere; or a callable ``progress(done, total)``): reports the work done.
     """
+    from ..sweep import progress_callback
+    progress = progress_callback(progress, "bifurcation")
     from ..chunks import check_engine
     from ..simulate import check_float, check_int, check_params
     params = check_params(params)

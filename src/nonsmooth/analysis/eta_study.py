@@ -146,7 +146,8 @@ def eta_study(params: ParamsBase, etas, *, transient: int = 300, record: int | N
     forcing periods, record ``record`` (default 200; ``points`` is its deprecated name)
     section points and then an orbit of ``orbit_periods`` (default 10; deprecated name
     ``portrait_periods``) periods at ``samples_per_period`` samples per period.
-    ``progress(done, total)`` is called between time slices.
+    ``progress`` (None or False: silent; True: a progress bar with a time estimate on a terminal,
+    plain lines elsewhere; or a callable ``progress(done, total)``) is called between time slices.
 
     Returns an ``xarray.Dataset`` over ``eta`` (and ``n`` for section points, time
     ``t_section``; ``sample`` for orbit samples, time ``orbit_t``) with
@@ -163,6 +164,8 @@ def eta_study(params: ParamsBase, etas, *, transient: int = 300, record: int | N
     ``store`` / ``engine``: chunked, resumable runs (:data:`ETA_CHUNK` etas per chunk, the
     exact model one more) and where they run (see ``nonsmooth.chunks``).
     """
+    from ..sweep import progress_callback
+    progress = progress_callback(progress, "eta study")
     from ..chunks import Plan, check_engine, chunk_bounds, execute, plan_solver
     from ..io import check_memory, flag_attrs, status_flags
     from ..simulate import check_params
@@ -187,8 +190,10 @@ def eta_study(params: ParamsBase, etas, *, transient: int = 300, record: int | N
     if distance_tol < 0:
         raise ParameterError(f"distance_tol: must be >= 0, got {distance_tol}")
     n = len(eta_vals)
-    check_memory(34.0 * (n + 1) * (record + orbit_periods * spp), "record",
-                 "record fewer section points, orbit periods or samples per period")
+    big = max((record, "record"), (orbit_periods, "orbit_periods"), (spp, "samples_per_period"))
+    check_memory(34.0 * (n + 1) * (record + orbit_periods * spp), big[1],
+                 "record fewer section points, orbit periods or samples per period",
+                 size=(big[0], 1))
     smooth = Solver(method="smooth", rtol=rtol, atol=atol, transition=transition,
                     model=params.model)
     exact = Solver(method="exact", model=params.model)

@@ -128,7 +128,11 @@ def parameter_map(params: ParamsBase, x=("omega", 0.8, 1.0, 100), y=("F0", 0.15,
     not settled), ``max_X``, ``min_X``, ``contact``, ``status`` (0 = ok; failed points have
     NaN data and period 0), ``transient_used`` and, with lambda1, ``lambda1``,
     ``lambda1_stderr``, ``motion`` (periodic / quasi-periodic / chaotic / not settled).
+    ``progress`` (None or False: silent; True: a progress bar with a time estimate on a terminal,
+    plain lines elsewhere; or a callable ``progress(done, total)``): reports the work done.
     """
+    from ..sweep import progress_callback
+    progress = progress_callback(progress, "map")
     from ..chunks import Plan, check_engine, execute, plan_solver
     from ..io import check_memory
     from ..simulate import check_float, check_int, check_params
@@ -151,13 +155,18 @@ def parameter_map(params: ParamsBase, x=("omega", 0.8, 1.0, 100), y=("F0", 0.15,
             params.replace(**{xname: float(xv), yname: float(yv)})
     ny, nx = ys.size, xs.size
     check_memory(_BYTES_PER_POINT * nx * ny, "x n",
-                 f"a {ny} x {nx} map holds {nx * ny} points; use fewer points per axis")
+                 f"a {ny} x {nx} map holds {nx * ny} points; use fewer points per axis",
+                 size=(nx, 1))
     solver = Solver(model=params.model, method=method, rtol=rtol, atol=atol,
                     transition=transition, max_steps=max_steps)
     lyap = wants_lyapunov(lyapunov, solver)
     if chunk is not None:
         chunk = check_int("chunk", chunk, 1)
     bounds = _layout(ny, nx, start, chunk)
+    in_chunk = (bounds[0][1] - bounds[0][0]) * (1 if start == "fresh" else nx)
+    check_memory(34.0 * in_chunk * record * 2, "record",
+                 f"a chunk of {in_chunk} points keeps {record:,} section points each; record "
+                 f"fewer periods (or use a smaller --chunk)", size=(record, 1))
     index = params.model.index
     spec = {"solver": plan_solver(solver, engine), "xs": xs, "ys": ys, "base": params.pack(),
             "ix": index[xname], "iy": index[yname], "start": start, "x0": x0, "v0": v0,

@@ -253,7 +253,9 @@ def poincare(params: ParamsBase, *, record: int | None = None, transient: int, x
     ``orbit_X``, ``orbit_V``, ``orbit_region`` (dimension ``sample``, time ``orbit_t``) covers
     ``orbit_periods`` further periods (default: the detected period, or 20 periods when not
     periodic) at ``orbit_samples`` per period; it starts on the last section point, so the
-    section points lie on it. ``progress(done, total)`` is called between time slices.
+    section points lie on it. ``progress`` (None or False: silent; True: a progress bar with a time
+    estimate on a terminal, plain lines elsewhere; or a callable ``progress(done, total)``) is
+    called between time slices.
 
     ``lyapunov`` (None = where tangent dynamics exist, i.e. not for eq. 12): also ``lambda1`` (largest Lyapunov exponent, per unit time) with its
     ``lambda1_stderr`` over ``record`` further periods of the attractor reached (tangent
@@ -263,6 +265,8 @@ def poincare(params: ParamsBase, *, record: int | None = None, transient: int, x
 
     Raises IntegrationError if the trajectory fails (sweeps record failures instead).
     """
+    from ..sweep import progress_callback
+    progress = progress_callback(progress, "poincare")
     from ..io import check_memory, flag_attrs, status_flags
     from ..simulate import check_int, renamed, start_trajectory
     from ..sweep import run_trajectories
@@ -276,8 +280,11 @@ def poincare(params: ParamsBase, *, record: int | None = None, transient: int, x
     orbit_samples = check_int("orbit_samples", orbit_samples, 1)
     if orbit_periods is not None:
         orbit_periods = check_int("orbit_periods", orbit_periods, 1)
-    check_memory(34.0 * (record + orbit_samples * (orbit_periods or 64)), "record",
-                 "record fewer section points")
+    big = max((record, "record"), (orbit_samples, "orbit_samples"),
+              (orbit_periods or 64, "orbit_periods"))
+    check_memory(34.0 * (record + orbit_samples * (orbit_periods or 64)), big[1],
+                 "record fewer section points or draw a shorter, coarser orbit",
+                 size=(big[0], 1))
     out = follow(p[None, None, :], solver, state[None, :], state.copy(), transient,
                  settle_tolerance(solver, settle), record, progress=progress)
     if out["status"][0, 0] == st.OK:

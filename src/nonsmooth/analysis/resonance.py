@@ -185,7 +185,12 @@ def resonance_curve(params: ParamsBase, omegas, *, method: str = "smooth", trans
 
     ``store`` / ``engine``: chunked, resumable sweeps and where they run, as for
     :func:`.bifurcation.bifurcation_diagram` (the refinement of the characteristic
-    frequencies runs locally after the sweeps)."""
+    frequencies runs locally after the sweeps).
+    ``progress`` (None or False: silent; True: a progress bar with a time estimate on a terminal,
+    plain lines elsewhere; or a callable ``progress(done, total)``): reports the work done.
+    """
+    from ..sweep import progress_callback
+    progress = progress_callback(progress, "resonance")
     from ..chunks import check_engine
     from ..simulate import check_float, check_int, check_params
     params = check_params(params)

@@ -42,6 +42,7 @@ N_SIGMA = 3.0
 NEUTRAL = 1e-6
 #: A converged orbit integrated again (other steps) must close to this (relative to 1 + |z|).
 CONFIRM_TOL = 1e-6
+_ORBIT_SAMPLE_BYTES = 40.0  # X, V, mode, bounds of one orbit sample (with their copies)
 ALIGN = 100  # periods of the transient that also carry the tangent vectors (alignment)
 _SLICE = 2000  # periods per kernel call (progress and Ctrl-C between calls)
 
@@ -102,7 +103,12 @@ def lyapunov(params, *, periods: int = 10000, transient: int = 1000, x0: float =
     ``exponent_sum`` and ``lyapunov_class`` (1 periodic: lambda1 < 0 beyond its error, 2
     quasi-periodic: within its error of 0, 3 chaotic: > 0 beyond it; :func:`classify`).
     Exponents of -inf mean that perturbations are annihilated (sticking, impacts with
-    r = 0)."""
+    r = 0).
+    ``progress`` (None or False: silent; True: a progress bar with a time estimate on a terminal,
+    plain lines elsewhere; or a callable ``progress(done, total)``): reports the work done.
+    """
+    from ..sweep import progress_callback
+    progress = progress_callback(progress, "lyapunov")
     params, solver, p, opts, state = start_trajectory(params, x0, v0, method, rtol, atol,
                                                       "eq13")
     periods = check_int("periods", periods, 1)
@@ -110,6 +116,9 @@ def lyapunov(params, *, periods: int = 10000, transient: int = 1000, x0: float =
     blocks = check_int("blocks", blocks, 2)
     setup = TangentSetup(solver)
     n, N = setup.n, setup.N
+    from ..io import check_memory
+    check_memory(8.0 * periods * (n + 2), "periods", "compute fewer periods (the log of every "
+                 "period's growth is kept for the error estimate)", size=(periods, 1))
     T = params.period
     total = transient + periods
     done = 0
@@ -227,6 +236,11 @@ def periodic_orbit(params, *, k: int = 1, x0: float = 0.0, v0: float = 0.0,
     transient = check_int("transient", transient, 0)
     max_iter = check_int("max_iter", max_iter, 1)
     spp = check_int("samples_per_period", samples_per_period, 1)
+    from ..io import check_memory
+    big = ("k", k) if k >= spp else ("samples_per_period", spp)  # name the larger factor
+    check_memory(_ORBIT_SAMPLE_BYTES * k * spp, big[0],
+                 f"the orbit is k x samples_per_period = {k:,} x {spp:,} samples",
+                 size=(big[1], 1))
     tol = check_float("tol", tol)
     if not tol > 0:
         raise ParameterError(f"tol: must be > 0, got {tol}")

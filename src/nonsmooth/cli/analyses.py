@@ -29,16 +29,21 @@ def HiddenIntOpt(name: str):
     return Annotated[Optional[int], typer.Option(name, hidden=True)]
 
 
-def value_range(lo: float, hi: float, steps: int, name: str = "range"):
-    """Evenly spaced values lo ... hi (validated: finite, lo < hi, steps >= 2)."""
+def value_range(lo: float, hi: float, steps: int, name: str = "range", branches: int = 1,
+                record: int = 0, field: str = "steps"):
+    """Evenly spaced values lo ... hi (validated: finite, lo < hi, steps >= 2; ``steps`` values
+    of ``branches`` sweeps recording ``record`` periods each must fit in memory, checked
+    before the values are built)."""
     import numpy as np
-    for field, v in (("from", lo), ("to", hi)):
+    from ..analysis.bifurcation import check_sweep_memory
+    for end, v in (("from", lo), ("to", hi)):
         if not math.isfinite(v):
-            raise ParameterError(f"{field}: must be finite, got {v}")
+            raise ParameterError(f"{end}: must be finite, got {v}")
     if not lo < hi:
         raise ParameterError(f"from/to: empty or reversed {name}: --from {lo:g} must be < --to {hi:g}")
     if steps < 2:
         raise ParameterError(f"steps: must be >= 2, got {steps}")
+    check_sweep_memory(steps, branches, record, field)
     return np.linspace(lo, hi, steps)
 
 
@@ -90,7 +95,7 @@ def poincare_cmd(
 
     if points is not None:  # deprecated name
         record = check_int("points", points, 1)
-    params = load_params(preset, set_, model, "table3")
+    params = load_params(preset, set_, model, "table3", method=method)
     method = resolve_method(params, method)
     preset = preset_label(params, preset, "table3")
     check_int("record", record, 1)
@@ -139,13 +144,14 @@ def bifurcation_cmd(
     from ..params import check_param_name
     from ..simulate import check_int
 
-    params = load_params(preset, set_, model, "table3")
+    params = load_params(preset, set_, model, "table3", method=method)
     method = resolve_method(params, method)
     preset = preset_label(params, preset, "table3")
     param = check_param_name(param or params.model.omega, params)
     if sweep not in SWEEPS:
         raise ParameterError(f"sweep: unknown sweep {sweep!r} (known: {', '.join(SWEEPS)})")
-    values = value_range(from_, to, steps, f"{param} range")
+    values = value_range(from_, to, steps, f"{param} range", 2 if sweep == "both" else 1,
+                         max(record, 0))
     for v in (values[0], values[-1]):
         params.replace(**{param: float(v)})
     check_int("transient", transient, 0)
@@ -196,11 +202,11 @@ def resonance_cmd(
     from ..analysis.resonance import resonance_curve
     from ..simulate import check_int
 
-    params = load_params(preset, set_, model, "fig6a")
+    params = load_params(preset, set_, model, "fig6a", method=method)
     method = resolve_method(params, method)
     preset = preset_label(params, preset, "fig6a")
     w = params.model.omega  # the model's forcing frequency
-    omegas = value_range(from_, to, steps, f"{w} range")
+    omegas = value_range(from_, to, steps, f"{w} range", 2, max(record, 0))
     for v in (omegas[0], omegas[-1]):
         params.replace(**{w: float(v)})
     check_int("transient", transient, 0)

@@ -43,7 +43,7 @@ def basins_cmd(
     from ..io import save_figure
     from ..sweep import Progress
 
-    params = load_params(preset, set_, model, "fig7")
+    params = load_params(preset, set_, model, "fig7", method=method)
     method = resolve_method(params, method)
     preset = preset_label(params, preset, "fig7")
     require_output(out, plot if plot is not None else orbits_plot)

@@ -28,8 +28,9 @@ PlotOpt = Annotated[Optional[Path], typer.Option(
     "--plot", help="figure file, format from the suffix: .png, .pdf, .svg, ... (none: PNG)")]
 MethodOpt = Annotated[Optional[str], typer.Option(
     "--method", show_default=False,
-    help="smooth (switch model, RKF45) or exact (eta = 0; event-driven); default: smooth, or "
-         "the model's first method if it has no smooth one")]
+    help="smooth (switch model, RKF45) or exact (eta = 0; event-driven: --set eta=... is "
+         "accepted and ignored, the exact model has no band); default: smooth, or the model's "
+         "first method if it has no smooth one")]
 RtolOpt = Annotated[float, typer.Option("--rtol", help="relative tolerance")]
 AtolOpt = Annotated[float, typer.Option("--atol", help="absolute tolerance")]
 TransitionOpt = Annotated[str, typer.Option("--transition", help="eq13 (paper, default) or eq12 (convex)")]
@@ -53,13 +54,19 @@ def get_model(name: str):
 
 
 def load_params(preset: str | None, sets: list[str] | None, model: str = "support",
-                default_preset: str | None = None):
+                default_preset: str | None = None, method: str | None = None):
     """The parameters of ``model``: a preset (the paper's for ``support``, where ``None``
     means ``default_preset``; else one of the model's ``presets``, ``None`` meaning its
-    defaults) with ``--set`` overrides applied. Every error names the field."""
+    defaults) with ``--set`` overrides applied. Every error names the field.
+
+    With ``method="exact"`` an ``eta`` override (the smoothed model's band) is not applied:
+    the exact model has no band, so ``--set eta=0`` is accepted there (the value must still be
+    a number) and the preset's eta, unused, stays in the parameters."""
     from ..params import parse_assignments
 
     m = get_model(model)
+    if method == "exact" and "exact" in m.methods and "eta" in m.param_names:
+        sets = _without_eta(sets)
     if m.name == "support" and m.source == "built-in":
         from ..presets import preset as get_preset
         base = get_preset(preset or default_preset or "table1")
@@ -76,6 +83,21 @@ def load_params(preset: str | None, sets: list[str] | None, model: str = "suppor
     values = _assignments(sets, m)
     base = m.preset(preset) if preset is not None else m.params()
     return base.replace(**values) if values else base
+
+
+def _without_eta(items) -> list:
+    """``--set`` items less those assigning eta (checked to be numbers)."""
+    out = []
+    for item in items or ():
+        name, _, value = item.partition("=")
+        if name.strip() == "eta":
+            try:
+                float(value)
+            except ValueError:
+                raise ParameterError(f"eta: expected a number, got {value.strip()!r}") from None
+            continue
+        out.append(item)
+    return out
 
 
 def _models_with(name: str) -> list:

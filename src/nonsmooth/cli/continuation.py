@@ -91,7 +91,7 @@ def continue_cmd(
     from ..params import check_param_name
     from ..simulate import check_float, check_int
 
-    params = load_params(preset, set_, model, "fig6a")
+    params = load_params(preset, set_, model, "fig6a", method=method or "exact")
     if method is None and "exact" in params.model.methods:
         method = "exact"
     method = resolve_method(params, method)
@@ -155,7 +155,7 @@ def _two_parameter(params, preset, param, param2, values, special, k, x0, v0, st
     check_param_name(param2, params)
     if values is None:
         raise ParameterError("values: --two-param needs --values FROM TO N")
-    grid = value_range(values[0], values[1], values[2], f"{param2} values")
+    grid = value_range(values[0], values[1], values[2], f"{param2} values", field="values")
     check_outputs(out, plot)
     ds = two_parameter_curve(params, param, param2, grid, special=special, k=k, x0=x0, v0=v0,
                              bounds=bounds, step=step, max_points=max_points, method=method,

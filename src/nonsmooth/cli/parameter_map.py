@@ -58,7 +58,7 @@ def map_cmd(
     With -o the finished chunks are kept in FILE.chunks and the same command resumes there."""
     from ..analysis.parameter_map import parameter_map, regimes
 
-    params = load_params(preset, set_, model, "table3")
+    params = load_params(preset, set_, model, "table3", method=method)
     method = resolve_method(params, method)
     preset = preset_label(params, preset, "table3")
     w = params.model.omega

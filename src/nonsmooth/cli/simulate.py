@@ -34,7 +34,7 @@ def simulate_cmd(
     """Integrate one trajectory; save X, V, region over time (netCDF) and a Fig. 3-style plot."""
     from ..simulate import simulate
 
-    params = load_params(preset, set_, model, "table1")
+    params = load_params(preset, set_, model, "table1", method=method)
     method = resolve_method(params, method)
     preset = preset_label(params, preset, "table1")
     require_output(out, plot)

@@ -76,7 +76,7 @@ def lyapunov_cmd(
     from ..analysis.stability import lyapunov
     from ..simulate import check_int
 
-    params = load_params(preset, set_, model, "table3")
+    params = load_params(preset, set_, model, "table3", method=method)
     method = resolve_method(params, method)
     preset = preset_label(params, preset, "table3")
     check_int("periods", periods, 1)
@@ -126,7 +126,7 @@ def orbit_cmd(
     from ..analysis.stability import periodic_orbit
     from ..simulate import check_int
 
-    params = load_params(preset, set_, model, "fig7")
+    params = load_params(preset, set_, model, "fig7", method=method or "exact")
     if method is None and "exact" in params.model.methods:
         method = "exact"
     method = resolve_method(params, method)

@@ -154,7 +154,9 @@ def basins(params: ParamsBase, *, x=(-3.0, 3.0), v=(-3.0, 3.0), grid=400, method
     ``max_period``: longest period looked for; ``early_stop``: stop a trajectory as soon as it
     enters a certified capture ball of a known attractor (False: every trajectory runs until
     its section repeats; same labels, much slower). ``workers``: threads (None = all cores;
-    results do not depend on it). ``progress(done, total)`` is called about every 0.1 s with
+    results do not depend on it). ``progress`` (None or False: silent; True: a progress bar with a
+    time estimate on a terminal, plain lines elsewhere; or a callable ``progress(done, total)``) is
+    called about every 0.1 s with
     the number of grid points decided. A ``UserWarning`` says when most points are undecided
     because ``max_periods`` was too small.
 
@@ -178,6 +180,8 @@ def basins(params: ParamsBase, *, x=(-3.0, 3.0), v=(-3.0, 3.0), grid=400, method
     each round is a chunk, continued from the attractors the rounds before it found, so the
     rounds run one after the other (on Dask: one worker at a time, with its threads).
     """
+    from ...sweep import progress_callback
+    progress = progress_callback(progress, "basins")
     from ...chunks import Plan, check_engine, execute, plan_solver
     from ..stability import wants_lyapunov
     engine = check_engine(engine)
@@ -194,7 +198,12 @@ def basins(params: ParamsBase, *, x=(-3.0, 3.0), v=(-3.0, 3.0), grid=400, method
     nw = resolve_workers(workers)
     n = nx * nv
     check_memory(n * _BYTES_PER_POINT, "grid",
-                 f"a {nx} x {nv} grid holds {n} initial conditions; use a smaller --grid")
+                 f"a {nx} x {nv} grid holds {n} initial conditions; use a smaller --grid",
+                 size=(max(nx, nv), 2))
+    # a round keeps the last 2 max_period section points of each of its trajectories
+    check_memory(n * 32.0 * (2 * max_period + N_CONFIRM), "max_period",
+                 f"each of the {n} initial conditions keeps its last {2 * max_period} section "
+                 f"points; look for shorter periods", size=(max_period, 1))
 
     xs = np.linspace(x_lo, x_hi, nx)
     vs = np.linspace(v_lo, v_hi, nv)

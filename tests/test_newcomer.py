@@ -1,0 +1,102 @@
+"""What a newcomer trips over (issue 24): sizes typed too large are refused in one line with the
+largest size that fits, ``progress`` takes True/False/None/a callable everywhere, and
+``--set eta=0`` is accepted with ``--method exact`` (the exact model has no band)."""
+
+import numpy as np
+import pytest
+
+import nonsmooth as ns
+from nonsmooth.errors import ParameterError
+
+from cli_helpers import one_line, run_cli
+
+HUGE = "100000000000"
+
+
+@pytest.mark.parametrize("argv,field", [
+    (["bifurcation", "--preset", "table3", "--param", "omega", "--from", "0.8", "--to", "1.0",
+      "--steps", HUGE, "-o", "{out}"], "steps"),
+    (["resonance", "--preset", "fig6a", "--from", "0.5", "--to", "1.6", "--steps", HUGE,
+      "-o", "{out}"], "steps"),
+    (["simulate", "--preset", "table1", "--periods", HUGE, "-o", "{out}"], "periods"),
+    (["poincare", "--preset", "table3", "--record", HUGE, "-o", "{out}"], "record"),
+    (["basins", "--preset", "fig7", "--grid", "10000000", "-o", "{out}"], "grid"),
+    (["map", "--x", "omega", "0.8", "1.0", "1000000", "--y", "F0", "0.1", "0.4", "1000000",
+      "-o", "{out}"], "x n"),
+    (["lyapunov", "--preset", "table3", "--periods", HUGE, "-o", "{out}"], "periods"),
+    (["orbit", "--preset", "fig7", "--k", HUGE, "-o", "{out}"], "k"),
+    (["eta-study", "--preset", "fig4", "--eta", "0.01", "--record", HUGE, "-o", "{out}"],
+     "record"),
+])
+def test_sizes_that_do_not_fit_are_refused_in_one_line_with_the_largest_that_fits(
+        argv, field, capsys, tmp_path):
+    out = tmp_path / "r.nc"
+    code, _, err = run_cli([a.format(out=out) for a in argv], capsys)
+    assert code == 2
+    one_line(err, f"{field}:")
+    assert "of memory" in err and "available" in err
+    if field != "record" or argv[0] != "eta-study":
+        assert "at most" in err and "fits" in err
+    assert not out.exists()
+
+
+def test_python_api_sizes_are_checked_too():
+    with pytest.raises(ParameterError, match=r"^samples_per_period: .* at most samples_per_"):
+        ns.periodic_orbit(ns.preset("fig7"), samples_per_period=10**11)
+    with pytest.raises(ParameterError, match=r"^periods: .* at most periods = "):
+        ns.lyapunov(ns.preset("table3"), periods=10**12)
+
+
+def test_the_largest_size_named_fits():
+    """The size the line names is accepted by the same check."""
+    from nonsmooth.analysis.bifurcation import check_sweep_memory
+    with pytest.raises(ParameterError) as exc:
+        check_sweep_memory(10**11, 2, 200, "steps")
+    largest = int(str(exc.value).split("at most steps = ")[1].split(" ")[0].replace(",", ""))
+    assert 1000 < largest < 10**11
+    check_sweep_memory(largest, 2, 200, "steps")
+
+
+@pytest.mark.parametrize("progress", [False, None, True])
+def test_progress_accepts_booleans_and_none(progress):
+    p = ns.preset("table3")
+    bif = ns.bifurcation_diagram(p, "omega", np.linspace(0.9, 0.92, 3), transient=10, record=4,
+                                 method="exact", progress=progress, lyapunov=False)
+    assert bif.sizes["omega"] == 3
+    ds = ns.simulate(p, periods=2, method="exact", progress=progress)
+    assert ds.sizes["t"] > 2
+
+
+def test_progress_callable_is_called_and_a_wrong_type_is_one_line():
+    calls = []
+    ns.simulate(ns.preset("table3"), periods=3, method="exact",
+                progress=lambda d, t: calls.append((d, t)))
+    assert calls and calls[-1][0] == calls[-1][1]
+    for f in (lambda: ns.simulate(ns.preset("table3"), periods=2, progress="yes"),
+              lambda: ns.poincare(ns.preset("table3"), record=2, transient=0, progress=3),
+              lambda: ns.parameter_map(ns.preset("table3"), x=("omega", 0.9, 0.92, 2),
+                                       y=("F0", 0.3, 0.31, 2), progress=1.5)):
+        with pytest.raises(ParameterError, match=r"^progress: expected True, False, None or a "):
+            f()
+
+
+def test_eta_zero_is_accepted_for_the_exact_method(capsys, tmp_path):
+    out = tmp_path / "ex.nc"
+    code, stdout, err = run_cli(["simulate", "--preset", "table3", "--set", "eta=0",
+                                 "--set", "omega=0.92", "--method", "exact", "--periods", "2",
+                                 "-o", str(out)], capsys)
+    assert code == 0, err
+    ds = ns.io.load_dataset(out)
+    ref = ns.simulate(ns.preset("table3").replace(omega=0.92), periods=2, method="exact")
+    assert np.array_equal(ds.X.values, ref.X.values)
+    # still refused for the smoothed model, and not a number is still an error
+    code, _, err = run_cli(["simulate", "--preset", "table3", "--set", "eta=0", "--periods", "2",
+                            "-o", str(tmp_path / "s.nc")], capsys)
+    assert code == 2
+    one_line(err, "eta:")
+    code, _, err = run_cli(["simulate", "--preset", "table3", "--set", "eta=x", "--method",
+                            "exact", "--periods", "2", "-o", str(tmp_path / "s.nc")], capsys)
+    assert code == 2
+    one_line(err, "eta: expected a number")
+    code, stdout, err = run_cli(["simulate", "--help"], capsys)
+    assert "ignored" in " ".join(stdout.split())
