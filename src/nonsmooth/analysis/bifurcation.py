@@ -276,8 +276,8 @@ def run_branches(params: ParamsBase, param: str, values, solver: Solver, *, dire
     if fresh:
         out["state"] = out["S"][0].copy()
     P = np.ascontiguousarray(np.broadcast_to(rows[None], (nbr,) + rows.shape))
-    classify_block(out, P, solver, transient, record, lyapunov, first_window=first_window,
-                   workers=workers)
+    classify_block(out, P, solver, transient, record, lyapunov, floquet=True,
+                   first_window=first_window, workers=workers)
     return out
 
 
@@ -372,22 +372,11 @@ def classify_block(out, P, solver: Solver, transient: int, record: int, lyapunov
         period, mx, mn, contact = summarize(out, P, solver, transient, record, workers)
         out.update(period=period, max_X=mx, min_X=mn, contact=contact)
         if lyapunov:
-            from .stability import classify_points, floquet_lambda1_points, lambda1_points
+            from .stability import classify_points, lambda1_evidence
             nb_, nv = period.shape
             flat_P, flat_S = P.reshape(nb_ * nv, -1), out["S"].reshape(nb_ * nv, -1)
-            per = period.ravel()
-            lam = np.full(nb_ * nv, np.nan)
-            err = np.full(nb_ * nv, np.nan)
-            periodic = np.flatnonzero(per > 0) if floquet else np.zeros(0, np.int64)
-            rest = np.setdiff1d(np.arange(nb_ * nv), periodic)
-            if periodic.size:
-                lam[periodic] = floquet_lambda1_points(flat_P[periodic], solver,
-                                                       flat_S[periodic], per[periodic],
-                                                       workers=workers)[0]
-                err[periodic] = np.where(np.isfinite(lam[periodic]), 0.0, np.nan)
-            if rest.size:
-                lam[rest], err[rest], _ = lambda1_points(flat_P[rest], solver, flat_S[rest],
-                                                         record, workers=workers)
+            per = period.ravel() if floquet else np.zeros(nb_ * nv, np.int64)
+            lam, err = lambda1_evidence(flat_P, solver, flat_S, record, per, workers=workers)
             lam, err = lam.reshape(nb_, nv), err.reshape(nb_, nv)
             failed = out["status"] != st.OK
             lam[failed] = np.nan

@@ -410,27 +410,39 @@ def _period_outputs(m):
 
 
 @nb.njit(cache=True, parallel=True)
-def _lambda1_many(fns, P, opts, states, align, periods, N, cmi, logs, status):
-    """One tangent vector per point over ``align`` + ``periods`` periods (normalised each
-    period): logs[i, k] = log growth of recorded period k (after the ``align`` periods that
-    turn the vector into the leading direction); status[i] the kernel status."""
+def _lambda1_many(fns, P, opts, states, align, periods, N, cmi, logs, status, Ys):
+    """One tangent vector per point (``Ys[i]``, carried in and out) over ``align`` + ``periods``
+    periods (normalised each period): logs[i, k] = log growth of recorded period k (after the
+    ``align`` periods that turn the vector into the leading direction); status[i] the kernel
+    status."""
     for i in nb.prange(P.shape[0]):
         Y = np.zeros((N, 1))
-        Y[0, 0] = 1.0
-        Y[1, 0] = 1.0
+        for r in range(N):
+            Y[r, 0] = Ys[i, r]
         L = np.empty((periods, 1))
         X, V, R, M, Xa, Xb = _period_outputs(periods)
         status[i] = advance_tangent(fns, P[i], opts, states[i], 1, align, periods, X, V, R, M,
                                     Xa, Xb, Y, L, cmi, 1)
         for k in range(periods):
             logs[i, k] = L[k, 0]
+        for r in range(N):
+            Ys[i, r] = Y[r, 0]
+
+
+#: Benettin's lambda1 of a non-periodic point runs in stages of FIRST_STAGE periods, then
+#: doubling, and stops once its standard error is at most REL_STDERR |lambda1| (or the record
+#: is used up): a record of at most FIRST_STAGE periods runs whole, in one stage.
+FIRST_STAGE = 1000
+REL_STDERR = 0.05
 
 
 def lambda1_points(P, solver, states, periods: int, *, blocks: int = 10, workers=None):
     """lambda1 (per unit time) and its standard error for many points at once: rows of packed
     parameters ``P`` from kernel ``states`` (copied; a specialised kernel's state is
-    re-classified for the generic kernel, mode -1), ``periods`` periods each after
-    max(20, periods // 4) periods of alignment, one tangent vector (all local cores).
+    re-classified for the generic kernel, mode -1), at most ``periods`` periods each after
+    max(20, min(periods, FIRST_STAGE) // 4) periods of alignment, one tangent vector (all
+    local cores). A point stops after the first stage (FIRST_STAGE periods, then doubling)
+    at which the standard error from ``blocks`` block means is <= REL_STDERR |lambda1|.
     Returns (lambda1, stderr, status) arrays."""
     from ..sweep import deferred_interrupts, threads
     setup = TangentSetup(solver)
@@ -439,16 +451,36 @@ def lambda1_points(P, solver, states, periods: int, *, blocks: int = 10, workers
     if solver.code != KERNEL_GENERIC:
         S[:, ST_MODE] = -1.0
         S[:, ST_H] = 0.0
-    logs = np.zeros((P.shape[0], periods))
-    status = np.zeros(P.shape[0], np.int64)
-    with threads(workers), deferred_interrupts():
-        _lambda1_many(setup.fns, P, setup.opts, S, max(20, periods // 4), periods, setup.N,
-                      setup.cmi, logs, status)
+    n = P.shape[0]
     om = P[:, solver.model.index[solver.model.omega]]
     T = 2.0 * np.pi / om
-    with np.errstate(invalid="ignore"):
-        lam = logs.mean(axis=1) / T
-        err = block_error(logs.T, blocks) / T  # one column per point
+    Ys = np.zeros((n, setup.N))
+    Ys[:, :2] = 1.0
+    logs = np.zeros((n, periods))
+    used = np.zeros(n, np.int64)
+    status = np.zeros(n, np.int64)
+    lam = np.full(n, np.nan)
+    err = np.full(n, np.nan)
+    active = np.arange(n)
+    align = max(20, min(periods, FIRST_STAGE) // 4)
+    while active.size:
+        done = int(used[active[0]])  # the active points have all run the same stages
+        m = min(periods - done, max(FIRST_STAGE, done))
+        Pa, Sa, Ya = P[active], S[active], Ys[active]
+        la = np.zeros((active.size, m))
+        sa = np.zeros(active.size, np.int64)
+        with threads(workers), deferred_interrupts():
+            _lambda1_many(setup.fns, Pa, setup.opts, Sa, align if done == 0 else 0, m,
+                          setup.N, setup.cmi, la, sa, Ya)
+        S[active], Ys[active], status[active] = Sa, Ya, sa
+        logs[active, done:done + m] = la
+        used[active] = done + m
+        with np.errstate(invalid="ignore"):
+            lam[active] = logs[active, :done + m].mean(axis=1) / T[active]
+            err[active] = block_error(logs[active, :done + m].T, blocks) / T[active]
+        finished = (done + m >= periods) | (sa != st.OK) | (err[active] <= REL_STDERR
+                                                              * np.abs(lam[active]))
+        active = active[~finished]
     bad = status != st.OK
     lam[bad] = np.nan
     err[bad] = np.nan
@@ -537,12 +569,37 @@ def wants_lyapunov(flag, solver) -> bool:
     return bool(flag)
 
 
+def lambda1_evidence(P, solver, states, periods: int, period, *, workers=None):
+    """(lambda1, stderr) of many points (rows of ``P``, kernel ``states`` on their attractors,
+    detected ``period`` per point, > 0 periodic): a periodic point's lambda1 is ln|mu_1| / (p T)
+    of its leading Floquet multiplier, from one tangent pass over its p periods
+    (:func:`floquet_lambda1_points`, stderr 0: exact up to the orbit's settling); any other
+    point's is Benettin's estimate over ``periods`` periods (:func:`lambda1_points`)."""
+    per = np.asarray(period, dtype=np.int64).ravel()
+    n = per.size
+    lam = np.full(n, np.nan)
+    err = np.full(n, np.nan)
+    periodic = np.flatnonzero(per > 0)
+    rest = np.flatnonzero(per <= 0)
+    if periodic.size:
+        lam[periodic] = floquet_lambda1_points(P[periodic], solver, states[periodic],
+                                               per[periodic], workers=workers)[0]
+        err[periodic] = np.where(np.isfinite(lam[periodic]), 0.0, np.nan)
+    if rest.size:
+        lam[rest], err[rest], _ = lambda1_points(P[rest], solver, states[rest], periods,
+                                                 workers=workers)
+    return lam, err
+
+
 def lyapunov_variables(P, solver, states, periods: int, period, dims) -> dict:
     """Dataset variables ``lambda1``, ``lambda1_stderr``, ``motion`` for points (rows of
     ``P``, kernel ``states`` on their attractors, detected ``period`` of shape ``dims``
-    sizes): :func:`lambda1_points` over ``periods`` periods, then :func:`classify_points`."""
+    sizes): :func:`lambda1_evidence` (Floquet on periodic points, Benettin over ``periods``
+    periods on the others), then :func:`classify_points`."""
     period = np.asarray(period)
-    lam, err, _ = lambda1_points(P, solver, states, periods)
+    P = np.atleast_2d(P)
+    states = np.asarray(states, dtype=np.float64).reshape(P.shape[0], -1)
+    lam, err = lambda1_evidence(P, solver, states, periods, period)
     lam = lam.reshape(period.shape)
     err = err.reshape(period.shape)
     motion = classify_points(lam, err, period)
@@ -559,8 +616,12 @@ def lyapunov_attrs(periods: int) -> dict:
     sweep (lambda1 over ``periods`` periods per point)."""
     return {
         "lambda1": {"long_name": "largest Lyapunov exponent (tangent dynamics with saltation "
-                                 "matrices)", "units": "1/s", "periods": periods},
-        "lambda1_stderr": {"long_name": "standard error of lambda1 (10 block means)",
-                           "units": "1/s"},
+                                 "matrices): ln|mu_1| / (p T) of the leading Floquet "
+                                 "multiplier at periodic points, Benettin's estimate over "
+                                 "at most 'periods' periods elsewhere (ended once its "
+                                 "standard error is below 5% of |lambda1|)", "units": "1/s",
+                    "periods": periods},
+        "lambda1_stderr": {"long_name": "standard error of lambda1 (10 block means; 0 at "
+                                        "periodic points)", "units": "1/s"},
         "motion": motion_attrs(),
     }

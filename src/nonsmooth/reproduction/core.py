@@ -296,6 +296,9 @@ def lyapunov_text(src, *, with_period: bool = True, **sel) -> str:
     if motion is None or int(motion) == 0:
         motion = classify(lam, err, per if per is not None else 0)
     verdict = VERDICTS.get(int(motion), "unknown")
+    if err == 0.0 and per is not None and per > 0:  # a periodic point's Floquet lambda1
+        return head + (f"lambda1 = {fmt(lam, 4)} /s = ln|mu_1| / (p T) of the leading Floquet "
+                       f"multiplier: {verdict}")
     val = f"lambda1 = {_pm(lam, err)} /s"
     if not err > 0 or not math.isfinite(err):
         return head + f"{val} (no error estimate): {verdict}"
