@@ -61,3 +61,39 @@ def test_lyapunov_off_keeps_the_old_variables():
     ds = ns.poincare(ns.preset("fig7"), transient=50, record=20, method="exact",
                      lyapunov=False)
     assert "lambda1" not in ds and int(ds.period) == 1
+
+
+def test_periodic_points_get_the_floquet_lambda1_without_error_bars():
+    """A periodic point of a sweep reports ln|mu_1| / (p T) of its orbit (one tangent pass over
+    p periods), stderr 0, the same number as the orbit Newton's shooting finds."""
+    params = ns.preset("fig7")
+    b = ns.bifurcation_diagram(params, "omega", [1.1, 1.11], sweep="up", method="exact",
+                               transient=300, record=50)
+    assert int(b.period[0, 0]) == 1 and float(b.lambda1_stderr[0, 0]) == 0.0
+    p = params.replace(omega=1.1)
+    orb = ns.periodic_orbit(p, x0=float(b.X[0, 0, -1]), v0=float(b.V[0, 0, -1]))
+    lam = math.log(float(orb.multiplier_abs[0])) / p.period
+    assert float(b.lambda1[0, 0]) == pytest.approx(lam, rel=1e-5)
+    sec = ns.poincare(p, transient=300, record=50, method="exact")
+    assert int(sec.period) == 1 and float(sec.lambda1_stderr) == 0.0
+    assert float(sec.lambda1) == pytest.approx(lam, rel=1e-5)
+
+
+def test_benettin_stops_at_its_error_target_and_short_records_run_whole(monkeypatch):
+    from nonsmooth.analysis import stability
+    from nonsmooth.kernels import Solver, new_state
+    p = ns.preset("fig4")
+    solver = Solver(method="exact", model=p.model)
+    P = p.pack()[None, :]
+    sec = ns.poincare(p, transient=300, record=20, method="exact", lyapunov=False)
+    S = new_state(float(sec.X[-1]), float(sec.V[-1]))[None, :]
+    lam, err, _ = stability.lambda1_points(P, solver, S, 30000)
+    assert 0 < err[0] <= stability.REL_STDERR * lam[0]  # ended at the target ...
+    monkeypatch.setattr(stability, "REL_STDERR", 0.0)
+    lam_all, err_all, _ = stability.lambda1_points(P, solver, S, 30000)
+    assert err_all[0] < err[0]  # ... long before the 30000 periods
+    assert abs(lam[0] - lam_all[0]) <= 3 * err[0]
+    # a record within the first stage runs whole: the target changes nothing
+    short = stability.lambda1_points(P, solver, S, 400)
+    monkeypatch.setattr(stability, "REL_STDERR", 1.0)
+    assert np.array_equal(short[0], stability.lambda1_points(P, solver, S, 400)[0])
