@@ -182,11 +182,6 @@ def run_trajectories(P, solver: Solver, states, *, per_period: int, n_skip: int,
     return out
 
 
-PROGRESS_DOC = ("``progress``: None or False (default: silent), True (a progress bar with a "
-                "time estimate on a terminal, plain lines elsewhere, for runs longer than 2 s) "
-                "or a callable ``progress(done, total)``")
-
-
 def progress_callback(progress, description: str):
     """The callable behind a ``progress`` argument of the public API: None or False -> None
     (silent); True -> a :class:`Progress` bar named ``description``; a callable
