@@ -211,6 +211,10 @@ BRANCH_CHUNK = 25
 FRESH_CHUNK = 100
 
 
+#: Cost of a recorded period of lambda1 evidence, in periods of the sweep (progress estimate).
+_EVIDENCE_COST = 3
+
+
 def run_branches(params: ParamsBase, param: str, values, solver: Solver, *, directions,
                  transient: int, record: int, x0: float, v0: float, settle: bool,
                  workers=None, progress=None, lyapunov: bool = False, store=None, engine=None,
@@ -272,12 +276,23 @@ def run_branches(params: ParamsBase, param: str, values, solver: Solver, *, dire
                     out["state"][d] = v
             else:
                 out[key][d, orders[d][a:b]] = v
-    execute(plan, collect, store=store, engine=engine, workers=workers, progress=progress)
+    # the classification after the chunks (extensions of converging sections, lambda1) is
+    # part of the work: the progress total holds an estimate of it, reported done at its end
+    report, seen = progress, [0]
+    if progress is not None:
+        extra = nbr * nv * record * (_EVIDENCE_COST if lyapunov else 1)
+
+        def report(done, total):
+            seen[0] = total + extra
+            progress(done, total + extra)
+    execute(plan, collect, store=store, engine=engine, workers=workers, progress=report)
     if fresh:
         out["state"] = out["S"][0].copy()
     P = np.ascontiguousarray(np.broadcast_to(rows[None], (nbr,) + rows.shape))
     classify_block(out, P, solver, transient, record, lyapunov, floquet=True,
                    first_window=first_window, workers=workers)
+    if progress is not None and seen[0]:
+        progress(seen[0], seen[0])
     return out
 
 
