@@ -278,14 +278,14 @@ def run_branches(params: ParamsBase, param: str, values, solver: Solver, *, dire
                 out[key][d, orders[d][a:b]] = v
     # the classification after the chunks (extensions of converging sections, lambda1) is
     # part of the work: the progress total holds an estimate of it, reported done at its end
-    report, seen = progress, [0]
-    if progress is not None:
-        extra = nbr * nv * record * (_EVIDENCE_COST if lyapunov else 1)
+    seen = [0]
+    extra = nbr * nv * record * (_EVIDENCE_COST if lyapunov else 1)
 
-        def report(done, total):
-            seen[0] = total + extra
-            progress(done, total + extra)
-    execute(plan, collect, store=store, engine=engine, workers=workers, progress=report)
+    def report(done, total):
+        seen[0] = total + extra
+        progress(done, total + extra)
+    execute(plan, collect, store=store, engine=engine, workers=workers,
+            progress=None if progress is None else report)
     if fresh:
         out["state"] = out["S"][0].copy()
     P = np.ascontiguousarray(np.broadcast_to(rows[None], (nbr,) + rows.shape))

@@ -26,7 +26,7 @@ from .. import status as st
 from ..errors import IntegrationError, ParameterError
 from ..integrate.contract import ST_H, ST_MODE
 from ..integrate.hybrid import advance_tangent
-from ..io import provenance_attrs
+from ..io import check_memory, provenance_attrs
 from ..kernels import mode_holds, output_buffers, run
 from ..models.base import KERNEL_GENERIC
 from ..simulate import check_float, check_int, start_trajectory
@@ -116,7 +116,6 @@ def lyapunov(params, *, periods: int = 10000, transient: int = 1000, x0: float =
     blocks = check_int("blocks", blocks, 2)
     setup = TangentSetup(solver)
     n, N = setup.n, setup.N
-    from ..io import check_memory
     check_memory(8.0 * periods * (n + 2), "periods", "compute fewer periods (the log of every "
                  "period's growth is kept for the error estimate)", size=(periods, 1))
     T = params.period
@@ -236,7 +235,6 @@ def periodic_orbit(params, *, k: int = 1, x0: float = 0.0, v0: float = 0.0,
     transient = check_int("transient", transient, 0)
     max_iter = check_int("max_iter", max_iter, 1)
     spp = check_int("samples_per_period", samples_per_period, 1)
-    from ..io import check_memory
     big = ("k", k) if k >= spp else ("samples_per_period", spp)  # name the larger factor
     check_memory(_ORBIT_SAMPLE_BYTES * k * spp, big[0],
                  f"the orbit is k x samples_per_period = {k:,} x {spp:,} samples",
