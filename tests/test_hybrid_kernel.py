@@ -295,6 +295,25 @@ def test_impact_oscillator_vs_scipy(closed):
     assert abs(state[ST_X] - y_end[0]) < 1e-7 and abs(state[ST_V] - y_end[1]) < 1e-7
 
 
+@pytest.mark.parametrize("closed,tol", [(False, 1e-4), (True, 1e-9)])
+def test_dip_inside_a_closed_form_piece_is_not_missed(closed, tol):
+    """X = A cos(t - 0.15), unforced, rises 1e-6 above the stop at X = 1 inside the first
+    closed-form piece [0, 0.7]. The cubic Hermite of (g, g') over that piece has its minimum
+    0.0027 away from the true one, where g is positive again, so a test of g at the Hermite's
+    minimum misses the impact; the certified test finds it at t = 0.15 - arccos(1 / A) (closed
+    form; on RKF45 steps the crossing is located on the step's interpolant, whose error is
+    magnified by the grazing slope)."""
+    A = 1.0 + 1e-6
+    p = params(w0=1.0, xi=0.0, F0=0.0, om=0.5, r=0.8)
+    opts = make_opts(rtol=1e-11, atol=1e-13, nmem=3, closed=closed)
+    state = make_state(A * math.cos(0.15), A * math.sin(0.15), mem=(0.0,) * 3)
+    code, X, V, R, M, Xmax, Xmin = run(IMPACT, p, opts, state)
+    assert code == st.OK
+    assert state[ST_EXTRA] >= 1  # impacts counted
+    assert abs(state[ST_EXTRA + 1] - (0.15 - math.acos(1.0 / A))) < tol
+    assert Xmax[0] <= 1.0 + 1e-9
+
+
 def test_three_dimensional_state_and_memory():
     p = params(xi=0.6)
     X0, V0, a = steady(p)
@@ -329,3 +348,24 @@ def test_non_finite_and_zeno():
     p = params(w0=1.0, xi=0.0, F0=0.0, om=1.0, b=2.0)
     code, *_ = run(STUCK, p, make_opts(), make_state(0.5, 0.0))
     assert code == st.ZENO
+
+
+def test_workspace_views_write_through_without_owning():
+    from nonsmooth.integrate.workspace import keep_alive, unowned, view
+
+    @nb.njit
+    def fill(ws, Y):
+        a = view(ws, 2, (3,))
+        b = view(ws, 5, (2, 3))
+        a[:] = 1.0
+        b[1, 2] = 7.0
+        Z = unowned(Y)
+        Z[0, 1] = 5.0
+        keep_alive(ws)
+        return b.strides[0], b.strides[1], b[0, 0]
+
+    ws = np.zeros(12)
+    Y = np.zeros((2, 2))
+    assert fill(ws, Y) == (24, 8, 0.0)
+    assert ws.tolist() == [0, 0, 1, 1, 1, 0, 0, 0, 0, 0, 7, 0]
+    assert Y[0, 1] == 5.0

@@ -19,7 +19,8 @@ Design summary
   once; more than ``ZENO_MAX`` consecutive transitions each < ``ZENO_DT`` T apart -> ZENO.
 * A guard with forcing terms (G[k, n+1], G[k, n+2]) is not a cubic along a step, and a step can
   be long (a stick phase has a zero error estimate, so its RKF45 steps grow to a whole output
-  interval): its exit test is certified. A step whose Hermite of (g, g') does not clear zero by
+  interval): its exit test is certified, and so is every guard on a closed-form piece (the
+  exact solution is not a cubic either). A step whose Hermite of (g, g') does not clear zero by
   its error bound (derivative bounds, ``pwlinear.HERM_ERR`` / a Bernstein test of the pointwise
   bound) is scanned piece by piece (``pwlinear.classify`` on -g, halving undecided pieces), and
   a located crossing is checked to be the first. So the answer does not depend on where outputs
@@ -29,6 +30,10 @@ Design summary
   (:mod:`.pwlinear`) in pieces of at most THETA = 0.7 rad of their fastest oscillation; the
   same exit test is applied to the exact piece ends, the crossing is located by Illinois on the
   exact closed-form state, and interior extrema of X are refined by Newton on V = 0 (exact).
+  The propagator of a full piece is computed once per mode and call.
+* Work arrays are views into one workspace without reference counting (:mod:`.workspace`):
+  numba would otherwise increment and decrement a reference count atomically for every array
+  passed to a model function, which took most of the time of a step.
 * The local time restarts at 0 at each forcing period and the step state (u, mode, h, mem) is
   all that carries over, so results are split-invariant bit for bit.
 
@@ -70,19 +75,21 @@ from .contract import (  # noqa: E402
     ST_X,
 )
 from .pwlinear import (BD_D2, BD_D3, BD_D4, BD_R, EXCLUDED, HERM_ERR, MC_A,  # noqa: E402
-                       MC_K, MC_LMAX, N_BD, N_MC, accel, classify, energy_norm, eval_state, functional_bounds,
+                       MC_K, MC_LMAX, N_BD, N_MC, accel, apply_propagator, classify, energy_norm, eval_state, functional_bounds,
                        herm_coeffs, hom_part, jerk, mode_coeffs, propagator)
 from .record import record_interval  # noqa: E402
 from .roots import illinois_point, illinois_update, quad_roots01  # noqa: E402
 from .rkstep import (_A, _B, _C, _E, _FM, _NS, _control, _cubic, _shrink,  # noqa: E402
                      _x_extrema)
 from .trig import cos_sin_small  # noqa: E402
+from .workspace import keep_alive, unowned, view  # noqa: E402
 
 MAX_MODES = 8  # mode codes 0..7 (bit mask M is uint8)
 THETA = 0.7  # longest closed-form piece, radians of the fastest oscillation of the mode
 ZENO_MAX = 64
 ZENO_DT = 1e-9
 S_TOL = 1e-13  # event location tolerance, fraction of the step
+_HERM_SLOPE = 4.0 / 27.0  # max |h10|, |h11| of the cubic Hermite basis on [0, 1]
 
 # mode classes for the closed-form table
 _MC_UNKNOWN = 0
@@ -365,7 +372,15 @@ def _mode_class(linear, closed, mode, pp, lin, MC, mcs, om, MF):
                 mcs[mode] = _MC_CLOSED
             else:
                 mcs[mode] = _MC_RESONANT
-    return mcs[mode]
+    return int(mcs[mode])
+
+
+@nb.njit(cache=True)
+def _cf_bounds(MC, mode, om, G, ng, GB):
+    """GB[k] = the derivative-bound coefficients (``pwlinear.functional_bounds``) of the guards
+    of a closed-form mode (they change only with the mode or its guards)."""
+    for k in range(ng):
+        functional_bounds(MC[mode], om, G[k, 0], G[k, 1], GB[k])
 
 
 @nb.njit(cache=True)
@@ -643,48 +658,80 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
     nmem = int(opts[OPT_NMEM])
     if n < 2 or nmem < 0 or n - 2 + nmem > N_STATE - ST_EXTRA:
         return st.NON_FINITE
-    pp = np.empty(len(p))
+    # every work array is a view into one workspace, without reference counting (see
+    # ``workspace``): ``ws`` itself is kept alive to the end of the call
+    nt = n if tan else 0  # tangent work arrays are empty without a tangent
+    mt = Y.shape[1]
+    nme = max(nmem, 1)
+    nj = n + nmem if tan else 0
+    sizes = (len(p), 10 * n, nme, MAX_GUARDS * (n + 3), MAX_MODES * (N_MC + 7), 4, N_BD * (1 + MAX_GUARDS),
+             (SCAN_DEPTH + 1) * 5, _NS * nt * mt, 6 * nt + nt * nj, 2 * nme if tan else 0,
+             len(cmi), mt)
+    total = 0
+    for z in sizes:
+        total += z
+    ws = np.zeros(total)
+    o = 0
+    pp = view(ws, o, (len(p),))
+    o += len(p)
+    u = view(ws, o, (n,))
+    u1 = view(ws, o + n, (n,))
+    f0 = view(ws, o + 2 * n, (n,))
+    f1 = view(ws, o + 3 * n, (n,))
+    us = view(ws, o + 4 * n, (n,))
+    k1 = view(ws, o + 5 * n, (n,))
+    k2 = view(ws, o + 6 * n, (n,))
+    k3 = view(ws, o + 7 * n, (n,))
+    k4 = view(ws, o + 8 * n, (n,))
+    k5 = view(ws, o + 9 * n, (n,))
+    o += 10 * n
+    mem = view(ws, o, (nme,))
+    o += nme
+    G = view(ws, o, (MAX_GUARDS, n + 3))
+    o += MAX_GUARDS * (n + 3)
+    MC = view(ws, o, (MAX_MODES, N_MC))
+    o += MAX_MODES * N_MC
+    MF = view(ws, o, (MAX_MODES,))
+    o += MAX_MODES
+    PT = view(ws, o, (MAX_MODES, 5))  # propagator of a full piece per mode (5: computed)
+    o += MAX_MODES * 5
+    mcs = view(ws, o, (MAX_MODES,))  # class of each mode (_MC_*), 0 = not known yet
+    o += MAX_MODES
+    lin = view(ws, o, (4,))
+    o += 4
+    BD = view(ws, o, (N_BD,))
+    o += N_BD
+    GB = view(ws, o, (MAX_GUARDS, N_BD))  # bound coefficients of the guards of a closed form
+    o += MAX_GUARDS * N_BD
+    stack = view(ws, o, (SCAN_DEPTH + 1, 5))
+    o += (SCAN_DEPTH + 1) * 5
+    KY = view(ws, o, (_NS, nt, mt))
+    o += _NS * nt * mt
+    W = view(ws, o, (nt,))
+    ue = view(ws, o + nt, (nt,))
+    fm = view(ws, o + 2 * nt, (nt,))
+    gk = view(ws, o + 3 * nt, (nt,))
+    uc = view(ws, o + 4 * nt, (nt,))
+    ua = view(ws, o + 5 * nt, (nt,))
+    J = view(ws, o + 6 * nt, (nt, nj))
+    o += 6 * nt + nt * nj
+    nmt = nme if tan else 0
+    me = view(ws, o, (nmt,))
+    mc = view(ws, o + nmt, (nmt,))
+    o += 2 * nmt
+    ma = view(ws, o, (len(cmi),))
+    o += len(cmi)
+    tw_last = view(ws, o, (mt,))
     pp[:] = p
+    Y = unowned(Y)  # owned by the caller for the whole call
+    L_out = unowned(L_out)
+    cmi = unowned(cmi)
     om = pp[int(opts[OPT_OMEGA])]
     if not (om > 0.0 and math.isfinite(om)):
         return st.NON_FINITE
     rtol = opts[OPT_RTOL]
     atol = opts[OPT_ATOL]
     closed = opts[OPT_CLOSED_FORM] == 1.0 and n == 2
-
-    u = np.empty(n)
-    u1 = np.empty(n)
-    f0 = np.empty(n)
-    f1 = np.empty(n)
-    us = np.empty(n)
-    k1 = np.empty(n)
-    k2 = np.empty(n)
-    k3 = np.empty(n)
-    k4 = np.empty(n)
-    k5 = np.empty(n)
-    mem = np.zeros(max(nmem, 1))
-    G = np.zeros((MAX_GUARDS, n + 3))
-    MC = np.zeros((MAX_MODES, N_MC))
-    mcs = np.zeros(MAX_MODES, np.int64)
-    MF = np.zeros(MAX_MODES)
-    lin = np.zeros(4)
-    BD = np.zeros(N_BD)
-    stack = np.zeros((SCAN_DEPTH + 1, 5))
-    # tangent work arrays (empty without a tangent)
-    nt = n if tan else 0
-    mt = Y.shape[1]
-    KY = np.zeros((_NS, nt, mt))
-    W = np.zeros(nt)
-    J = np.zeros((nt, n + nmem if tan else 0))
-    ue = np.zeros(nt)
-    fm = np.zeros(nt)
-    gk = np.zeros(nt)
-    uc = np.zeros(nt)
-    ua = np.zeros(nt)
-    me = np.zeros(len(mem) if tan else 0)
-    mc = np.zeros(len(mem) if tan else 0)
-    ma = np.zeros(len(cmi))
-    tw_last = np.zeros(mt)
     for q in range(len(cmi)):
         if cmi[q] < 0 or cmi[q] >= nmem:
             return st.NON_FINITE
@@ -715,13 +762,17 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
         mode = initial(1.0, 0.0, u, pp, mem)
     if mode < 0 or mode >= MAX_MODES:
         _store(state, u, n, mem, nmem, mode, h)
+        keep_alive(ws)
         return st.EVENT_FAILED
     ng = min(max(guards(mode, pp, mem, G), 0), MAX_GUARDS)
     cls = _mode_class(linear, closed, mode, pp, lin, MC, mcs, om, MF)
     if cls == _MC_RESONANT:
         _store(state, u, n, mem, nmem, mode, h)
+        keep_alive(ws)
         return st.RESONANCE
     cf = cls == _MC_CLOSED
+    if cf:
+        _cf_bounds(MC, mode, om, G, ng, GB)
 
     tau = 0.0
     C = 1.0
@@ -755,7 +806,16 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
                     last = Lm >= rem
                     hs = rem if last else Lm
                     y0, z0 = hom_part(MC, mode, om, u[0], u[1], C, S)
-                    X1, V1, A1, y1, z1, C1, S1 = eval_state(MC, mode, om, y0, z0, C, S, hs)
+                    if last:
+                        X1, V1, A1, y1, z1, C1, S1 = eval_state(MC, mode, om, y0, z0, C, S, hs)
+                    else:  # a full piece: its propagator is the same every time
+                        if PT[mode, 4] == 0.0:
+                            PT[mode, 0], PT[mode, 1], PT[mode, 2], PT[mode, 3] = propagator(
+                                MC, mode, om, hs)
+                            PT[mode, 4] = 1.0
+                        X1, V1, A1, y1, z1, C1, S1 = apply_propagator(
+                            MC, mode, om, y0, z0, C, S, PT[mode, 0], PT[mode, 1], PT[mode, 2],
+                            PT[mode, 3])
                     if not (math.isfinite(X1) and math.isfinite(V1)):
                         code = st.NON_FINITE
                         break
@@ -779,6 +839,7 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
 
                 # ---- exit test for every guard; earliest crossing located by Illinois ----
                 s_best = 2.0
+                En = -1.0  # energy norm of a closed-form piece, when needed
                 for k in range(ng):
                     g0 = _gval(G, k, n, u, C, S)
                     d0 = _dgval(G, k, n, f0, C, S, om)
@@ -802,6 +863,15 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
                     if g1 < 0.0:
                         hi = 1.0
                         ghi = g1
+                    # certified where g along the step is not a cubic: on a closed-form piece,
+                    # and for guards with forcing terms. Otherwise g on the step's interpolant
+                    # is the Hermite of (g, g'), and a Hermite that stays clear of zero by the
+                    # bound of its derivative basis functions (4/27) has no negative minimum
+                    cert = cf or G[k, n + 1] != 0.0 or G[k, n + 2] != 0.0
+                    if not cert and hi > 1.0:
+                        sl = hs * (abs(d0) + abs(d1))
+                        if min(g0, g1) - _HERM_SLOPE * sl > 1e-9 * (abs(g0) + abs(g1) + sl):
+                            continue
                     b1, b2, b3 = herm_coeffs(g0, d0, g1, d1, hs)
                     r1, r2 = quad_roots01(b1, 2.0 * b2, 3.0 * b3)
                     for q in (r1, r2):
@@ -811,19 +881,22 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
                             if gq < 0.0:
                                 hi = q
                                 ghi = gq
-                    # certified for guards with forcing terms, whose values along a step are
-                    # not a cubic: the Hermite of (g, g') is then within HERM_ERR M4 hs^4 of g
-                    # and a step it does not clear is scanned (``_scan_step``). Guards without
-                    # forcing terms are cubics along an RKF45 step (the test above is exact on
-                    # the interpolant); on a closed-form piece (<= THETA rad) the Hermite test
-                    # stands, as before
-                    cert = G[k, n + 1] != 0.0 or G[k, n + 2] != 0.0
+                    # certified: the Hermite of (g, g') is within HERM_ERR M4 hs^4 of g and a
+                    # step it does not clear is scanned (``_scan_step``)
                     if cert and hi > 1.0:
                         hm = min(g0, g1)
                         for q in (r1, r2):
                             if 0.0 < q < 1.0:
                                 hm = min(hm, g0 + q * (b1 + q * (b2 + q * b3)))
-                        M4 = _guard_bounds(cf, G, k, n, q2, q3, om, hs, MC, mode, y0, z0, BD)[2]
+                        if cf:  # the guard's bound coefficients are those of the mode entry
+                            if En < 0.0:
+                                En = energy_norm(MC, mode, y0, z0)
+                            om2 = om * om
+                            M4 = GB[k, BD_D4] * En + om2 * om2 * (
+                                GB[k, BD_R] + math.hypot(G[k, n + 1], G[k, n + 2]))
+                        else:
+                            M4 = _guard_bounds(cf, G, k, n, q2, q3, om, hs, MC, mode, y0, z0,
+                                               BD)[2]
                         if not (hm > HERM_ERR * M4 * ((hs * hs) * (hs * hs)) or _herm_clear(g0, d0, g1, d1, hs,
                                                                          M4)):
                             hi, ghi = _scan_step(cf, g0, d0, g1, d1, u, f0, u1, f1, C, S, C1, S1,
@@ -930,6 +1003,8 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
                     code = st.RESONANCE
                     break
                 cf = cls == _MC_CLOSED
+                if cf:
+                    _cf_bounds(MC, mode, om, G, ng, GB)
                 _deriv(cf, field, mode, tau, C, S, u, pp, mem, f0, MC, om)
                 if tan and not _saltation(transition, old_mode, k_tr, tau, C, S, om, n, ue, me,
                                           fm, gk, gdot, mode, u, mem, f0, pp, Y, cmi, uc, mc,
@@ -960,6 +1035,7 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
         record_interval(it, n_skip, u[0], u[1], mode, mask, xmax, xmin, X_out, V_out, R_out,
                         M_out, Xmax_out, Xmin_out)
     _store(state, u, n, mem, nmem, mode, h)
+    keep_alive(ws)  # the views above are not used after this
     return code
 
 

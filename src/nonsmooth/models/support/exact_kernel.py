@@ -101,6 +101,7 @@ from ...integrate.pwlinear import (
     refine_root,
 )
 from ...integrate.record import record_interval, store_state
+from ...integrate.workspace import keep_alive, unowned
 from .switch import beta_ratio
 
 FREE = 0  # mode code of free flight (Gamma-)
@@ -264,9 +265,14 @@ def advance_exact(p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
     V = state[ST_V]
     if not (math.isfinite(X) and math.isfinite(V)):
         return st.NON_FINITE
-    MC, FN, TB, TL, BD, sw_f, sw_s, sw_n, code = _tables(w0, ws, xi, xis, F0, om, r, support)
+    MCo, FNo, TBo, TLo, BDo, sw_fo, sw_so, sw_no, code = _tables(w0, ws, xi, xis, F0, om, r,
+                                                                 support)
     if code != st.OK:
         return code
+    # the tables without reference counting in the loop (see ``integrate.workspace``); the
+    # owners are kept alive to the end
+    MC, FN, TB, TL, BD = unowned(MCo), unowned(FNo), unowned(TBo), unowned(TLo), unowned(BDo)
+    sw_f, sw_s, sw_n = unowned(sw_fo), unowned(sw_so), unowned(sw_no)
 
     T = 2.0 * math.pi / om
     dt = T / per_period
@@ -460,4 +466,12 @@ def advance_exact(p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
         record_interval(it, n_skip, X, V, mode, mask, xmax, xmin, X_out, V_out, R_out, M_out,
                         Xmax_out, Xmin_out)
     store_state(state, X, V, V, mode, 0.0)
+    keep_alive(MCo)
+    keep_alive(FNo)
+    keep_alive(TBo)
+    keep_alive(TLo)
+    keep_alive(BDo)
+    keep_alive(sw_fo)
+    keep_alive(sw_so)
+    keep_alive(sw_no)
     return code
