@@ -1,5 +1,6 @@
 """Benchmark: resonance curve fig6a, omega in [0.5, 1.6], 400 values, up and down sweeps with
-continuation, omega_a/b/c refined to 1e-4.  Run: python benchmarks/bench_resonance.py [preset]"""
+continuation, omega_a/b/c refined to 1e-4.  Run: python benchmarks/bench_resonance.py [preset]
+The last line is the seconds of the timed sweep."""
 
 import os
 import sys
@@ -23,6 +24,7 @@ def main():
           f"loadavg {load0[0]:.2f} -> {os.getloadavg()[0]:.2f}")
     print(f"omega_a = {a['omega_a']:.5f}, omega_b = {a['omega_b']:.5f}, omega_c = {a['omega_c']:.5f}; "
           f"mean transient used {float(ds.transient_used.mean()):.0f} periods")
+    print(f"{dt:.4f}")  # last line: seconds of the timed sweep (for ../shared/tools/side-by-side)
 
 
 if __name__ == "__main__":

@@ -10,8 +10,11 @@ every new process. What does work is a module in which the model's functions are
 kernel body is the source of :mod:`.hybrid` itself, written once per (model, method) to a file
 whose name is a digest of the model's source, the kernel sources and the numba version, with
 
-* the model's functions bound as module globals (``field``, ``jacobian``, ...), replacing the
-  unpacking of the ``fns`` tuple in ``_advance``;
+* the model's functions bound as module globals (``_FIELD``, ``_JACOBIAN``, ...), replacing
+  the unpacking of the ``fns`` tuple in ``_advance``, and every call of a model function
+  rewritten to call the global, with ``inline="always"``: numba inlines them at its IR level
+  (LLVM does not inline across numba's separately compiled functions, and a function held in
+  a local variable is not inlined at all);
 * the helpers that receive a model function (``_rk_step``, ``_mode_class``, ``_saltation``)
   inlined at numba's IR level, so that no compiled call boundary passes a function;
 * two entry points, ``advance`` and ``advance_tangent``, with the kernel contract's arguments
@@ -87,12 +90,12 @@ import nonsmooth as _ns
 from nonsmooth.models.base import _no_linear
 
 _M = _ns.model({_model_spec(model)!r}).method({method!r})
-_FIELD = _nb.njit(_M.field)
-_JACOBIAN = _nb.njit(_M.jacobian)
-_GUARDS = _nb.njit(_M.guards)
-_TRANSITION = _nb.njit(_M.transition)
-_INITIAL = _nb.njit(_M.initial)
-_LINEAR = _nb.njit(_M.linear or _no_linear)
+_FIELD = _nb.njit(inline='always')(_M.field)
+_JACOBIAN = _nb.njit(inline='always')(_M.jacobian)
+_GUARDS = _nb.njit(inline='always')(_M.guards)
+_TRANSITION = _nb.njit(inline='always')(_M.transition)
+_INITIAL = _nb.njit(inline='always')(_M.initial)
+_LINEAR = _nb.njit(inline='always')(_M.linear or _no_linear)
 '''
     footer = '''
 
@@ -115,6 +118,9 @@ def advance_tangent(p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_o
     return _advance(0, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out, M_out,
                     Xmax_out, Xmin_out, Y, L_out, cmi, qr)
 '''
+    for fn, glob in (("field", "_FIELD"), ("jacobian", "_JACOBIAN"), ("guards", "_GUARDS"),
+                     ("transition", "_TRANSITION"), ("initial", "_INITIAL"), ("linear", "_LINEAR")):
+        src = re.sub(r"(?<![\w.])" + fn + r"\(", glob + "(", src)
     return header + src + footer
 
 

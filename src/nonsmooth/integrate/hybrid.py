@@ -376,11 +376,13 @@ def _mode_class(linear, closed, mode, pp, lin, MC, mcs, om, MF):
 
 
 @nb.njit(cache=True)
-def _cf_bounds(MC, mode, om, G, ng, GB):
+def _cf_bounds(MC, mode, om, G, ng, n, GB):
     """GB[k] = the derivative-bound coefficients (``pwlinear.functional_bounds``) of the guards
-    of a closed-form mode (they change only with the mode or its guards)."""
+    of a closed-form mode (they change only with the mode or its guards), with the amplitude of
+    the guard's own forcing terms added to the harmonic amplitude BD_R."""
     for k in range(ng):
         functional_bounds(MC[mode], om, G[k, 0], G[k, 1], GB[k])
+        GB[k, BD_R] += math.hypot(G[k, n + 1], G[k, n + 2])
 
 
 @nb.njit(cache=True)
@@ -495,10 +497,38 @@ def _rk_tangent(jacobian, mode, tau, C, S, h, om, n, u, k0, k1, k2, k3, k4, k5, 
             for r in range(n):
                 J[r, n + cmi[q]] = 0.0
         jacobian(mode, tau + _C[i] * h, C * cw - S * sw, S * cw + C * sw, us, pp, mem, J)
+        if n == 2:  # the same arithmetic in scalars (most models): tiny loops cost more
+            j00 = J[0, 0]
+            j01 = J[0, 1]
+            j10 = J[1, 0]
+            j11 = J[1, 1]
+            for c in range(m):
+                s0 = 0.0
+                s1 = 0.0
+                for j in range(i):
+                    s0 += _A[i, j] * KY[j, 0, c]
+                    s1 += _A[i, j] * KY[j, 1, c]
+                w0 = Y[0, c] + h * s0
+                w1 = Y[1, c] + h * s1
+                acc0 = 0.0
+                acc0 += j00 * w0
+                acc0 += j01 * w1
+                acc1 = 0.0
+                acc1 += j10 * w0
+                acc1 += j11 * w1
+                for q in range(ncm):
+                    yq = Y[2 + q, c]
+                    acc0 += J[0, 2 + cmi[q]] * yq
+                    acc1 += J[1, 2 + cmi[q]] * yq
+                KY[i, 0, c] = acc0
+                KY[i, 1, c] = acc1
+            continue
         for c in range(m):
-            for r in range(n):
-                W[r] = Y[r, c] + h * (a0 * KY[0, r, c] + a1 * KY[1, r, c] + a2 * KY[2, r, c]
-                                      + a3 * KY[3, r, c] + a4 * KY[4, r, c])
+            for r in range(n):  # the stages before this one (_A is strictly lower triangular)
+                acc = 0.0
+                for j in range(i):
+                    acc += _A[i, j] * KY[j, r, c]
+                W[r] = Y[r, c] + h * acc
             for r in range(n):
                 acc = 0.0
                 for q in range(n):
@@ -732,6 +762,7 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
     rtol = opts[OPT_RTOL]
     atol = opts[OPT_ATOL]
     closed = opts[OPT_CLOSED_FORM] == 1.0 and n == 2
+    om4 = (om * om) * (om * om)
     for q in range(len(cmi)):
         if cmi[q] < 0 or cmi[q] >= nmem:
             return st.NON_FINITE
@@ -772,7 +803,7 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
         return st.RESONANCE
     cf = cls == _MC_CLOSED
     if cf:
-        _cf_bounds(MC, mode, om, G, ng, GB)
+        _cf_bounds(MC, mode, om, G, ng, n, GB)
 
     tau = 0.0
     C = 1.0
@@ -872,6 +903,14 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
                         sl = hs * (abs(d0) + abs(d1))
                         if min(g0, g1) - _HERM_SLOPE * sl > 1e-9 * (abs(g0) + abs(g1) + sl):
                             continue
+                    elif cf and hi > 1.0:  # the same, less the Hermite's error bound
+                        if En < 0.0:
+                            En = energy_norm(MC, mode, y0, z0)
+                        sl = hs * (abs(d0) + abs(d1))
+                        if min(g0, g1) - _HERM_SLOPE * sl - HERM_ERR * (
+                                GB[k, BD_D4] * En + om4 * GB[k, BD_R]) * ((hs * hs) * (hs * hs)
+                                ) > 1e-9 * (abs(g0) + abs(g1) + sl):
+                            continue
                     b1, b2, b3 = herm_coeffs(g0, d0, g1, d1, hs)
                     r1, r2 = quad_roots01(b1, 2.0 * b2, 3.0 * b3)
                     for q in (r1, r2):
@@ -891,9 +930,7 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
                         if cf:  # the guard's bound coefficients are those of the mode entry
                             if En < 0.0:
                                 En = energy_norm(MC, mode, y0, z0)
-                            om2 = om * om
-                            M4 = GB[k, BD_D4] * En + om2 * om2 * (
-                                GB[k, BD_R] + math.hypot(G[k, n + 1], G[k, n + 2]))
+                            M4 = GB[k, BD_D4] * En + om4 * GB[k, BD_R]
                         else:
                             M4 = _guard_bounds(cf, G, k, n, q2, q3, om, hs, MC, mode, y0, z0,
                                                BD)[2]
@@ -1004,7 +1041,7 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
                     break
                 cf = cls == _MC_CLOSED
                 if cf:
-                    _cf_bounds(MC, mode, om, G, ng, GB)
+                    _cf_bounds(MC, mode, om, G, ng, n, GB)
                 _deriv(cf, field, mode, tau, C, S, u, pp, mem, f0, MC, om)
                 if tan and not _saltation(transition, old_mode, k_tr, tau, C, S, om, n, ue, me,
                                           fm, gk, gdot, mode, u, mem, f0, pp, Y, cmi, uc, mc,
