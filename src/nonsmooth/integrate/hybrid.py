@@ -694,9 +694,9 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
     mt = Y.shape[1]
     nme = max(nmem, 1)
     nj = n + nmem if tan else 0
-    sizes = (len(p), 10 * n, nme, MAX_GUARDS * (n + 3), MAX_MODES * (N_MC + 7), 4, N_BD * (1 + MAX_GUARDS),
-             (SCAN_DEPTH + 1) * 5, _NS * nt * mt, 6 * nt + nt * nj, 2 * nme if tan else 0,
-             len(cmi), mt)
+    sizes = (len(p), 10 * n, nme, MAX_GUARDS * (n + 3), MAX_MODES * (N_MC + 7), 4,
+             N_BD * (1 + MAX_GUARDS), (SCAN_DEPTH + 1) * 5, _NS * nt * mt, 6 * nt + nt * nj,
+             2 * nme if tan else 0, len(cmi), mt)
     total = 0
     for z in sizes:
         total += z
@@ -752,6 +752,8 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
     ma = view(ws, o, (len(cmi),))
     o += len(cmi)
     tw_last = view(ws, o, (mt,))
+    if o + mt != total:  # the views above and ``sizes`` must agree (views are not checked)
+        return st.NON_FINITE
     pp[:] = p
     Y = unowned(Y)  # owned by the caller for the whole call
     L_out = unowned(L_out)
