@@ -689,7 +689,9 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
     if n < 2 or nmem < 0 or n - 2 + nmem > N_STATE - ST_EXTRA:
         return st.NON_FINITE
     # every work array is a view into one workspace, without reference counting (see
-    # ``workspace``): ``ws`` itself is kept alive to the end of the call
+    # ``workspace``). numba frees ``ws`` after its last use on each path, so the rule is: a
+    # path that reads a view after ``ws`` was made ends with ``keep_alive(ws)`` (the main loop's
+    # end, the early returns after ``_store``); a return before any later read needs nothing
     nt = n if tan else 0  # tangent work arrays are empty without a tangent
     mt = Y.shape[1]
     nme = max(nmem, 1)
@@ -752,8 +754,8 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
     ma = view(ws, o, (len(cmi),))
     o += len(cmi)
     tw_last = view(ws, o, (mt,))
-    if o + mt != total:  # the views above and ``sizes`` must agree (views are not checked)
-        return st.NON_FINITE
+    if o + mt != total:  # the views above and ``sizes`` must agree (views are not bounds-
+        return st.NON_FINITE  # checked); a mismatch is a bug of this function, caught by tests
     pp[:] = p
     Y = unowned(Y)  # owned by the caller for the whole call
     L_out = unowned(L_out)
