@@ -544,10 +544,15 @@ def _rk_tangent(jacobian, mode, tau, C, S, h, om, n, u, k0, k1, k2, k3, k4, k5, 
 
 
 @nb.njit(cache=True, inline="always", fastmath=_FM)
-def _cf_tangent(MC, mode, om, h, Y):
+def _cf_tangent(MC, mode, om, h, Y, PT):
     """Y <- Phi(h) Y for a closed-form mode: Phi = exp(A h), A = [[0, 1], [-k, -c]] (the
-    mode's homogeneous propagator); memory rows are unchanged."""
-    eC, eS, cw, sw = propagator(MC, mode, om, h)
+    mode's homogeneous propagator, from the table PT for a full piece); memory rows are
+    unchanged."""
+    if h == MC[mode, MC_LMAX] and PT[mode, 4] == 1.0:
+        eC = PT[mode, 0]
+        eS = PT[mode, 1]
+    else:
+        eC, eS, cw, sw = propagator(MC, mode, om, h)
     a = MC[mode, MC_A]
     k = MC[mode, MC_K]
     p00 = eC - a * eS
@@ -995,7 +1000,7 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
                     rejected = False
                 if tan:
                     if cf:
-                        _cf_tangent(MC, mode, om, hs, Y)
+                        _cf_tangent(MC, mode, om, hs, Y, PT)
                     else:
                         _rk_tangent(jacobian, mode, tau, C, S, hs, om, n, u, f0, k1, k2, k3, k4,
                                     k5, pp, mem, Y, W, KY, J, us, cmi)
