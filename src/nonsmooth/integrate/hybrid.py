@@ -75,8 +75,9 @@ from .contract import (  # noqa: E402
     ST_X,
 )
 from .pwlinear import (BD_D2, BD_D3, BD_D4, BD_R, EXCLUDED, HERM_ERR, MC_A,  # noqa: E402
-                       MC_K, MC_LMAX, N_BD, N_MC, accel, apply_propagator, classify, energy_norm, eval_state, functional_bounds,
-                       herm_coeffs, hom_part, jerk, mode_coeffs, propagator)
+                       MC_K, MC_LMAX, N_BD, N_MC, accel, apply_propagator, classify,
+                       energy_norm, eval_state, functional_bounds, herm_coeffs, hom_part, jerk,
+                       mode_coeffs, propagator)
 from .record import record_interval  # noqa: E402
 from .roots import illinois_point, illinois_update, quad_roots01  # noqa: E402
 from .rkstep import (_A, _B, _C, _E, _FM, _NS, _control, _cubic, _shrink,  # noqa: E402
@@ -711,16 +712,9 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
     o = 0
     pp = view(ws, o, (len(p),))
     o += len(p)
-    u = view(ws, o, (n,))
-    u1 = view(ws, o + n, (n,))
-    f0 = view(ws, o + 2 * n, (n,))
-    f1 = view(ws, o + 3 * n, (n,))
-    us = view(ws, o + 4 * n, (n,))
-    k1 = view(ws, o + 5 * n, (n,))
-    k2 = view(ws, o + 6 * n, (n,))
-    k3 = view(ws, o + 7 * n, (n,))
-    k4 = view(ws, o + 8 * n, (n,))
-    k5 = view(ws, o + 9 * n, (n,))
+    rows = view(ws, o, (10, n))  # the rows of a view are views too
+    u, u1, f0, f1, us = rows[0], rows[1], rows[2], rows[3], rows[4]
+    k1, k2, k3, k4, k5 = rows[5], rows[6], rows[7], rows[8], rows[9]
     o += 10 * n
     mem = view(ws, o, (nme,))
     o += nme
@@ -744,12 +738,8 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
     o += (SCAN_DEPTH + 1) * 5
     KY = view(ws, o, (_NS, nt, mt))
     o += _NS * nt * mt
-    W = view(ws, o, (nt,))
-    ue = view(ws, o + nt, (nt,))
-    fm = view(ws, o + 2 * nt, (nt,))
-    gk = view(ws, o + 3 * nt, (nt,))
-    uc = view(ws, o + 4 * nt, (nt,))
-    ua = view(ws, o + 5 * nt, (nt,))
+    rows = view(ws, o, (6, nt))
+    W, ue, fm, gk, uc, ua = rows[0], rows[1], rows[2], rows[3], rows[4], rows[5]
     J = view(ws, o + 6 * nt, (nt, nj))
     o += 6 * nt + nt * nj
     nmt = nme if tan else 0
@@ -907,18 +897,19 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
                     # and for guards with forcing terms. Otherwise g on the step's interpolant
                     # is the Hermite of (g, g'), and a Hermite that stays clear of zero by the
                     # bound of its derivative basis functions (4/27) has no negative minimum
+                    # (on a closed-form piece: less the Hermite's error bound, also certified)
                     cert = cf or G[k, n + 1] != 0.0 or G[k, n + 2] != 0.0
-                    if not cert and hi > 1.0:
+                    M4 = 0.0  # bound of |g''''| over a closed-form piece
+                    if hi > 1.0 and (cf or not cert):
                         sl = hs * (abs(d0) + abs(d1))
-                        if min(g0, g1) - _HERM_SLOPE * sl > 1e-9 * (abs(g0) + abs(g1) + sl):
-                            continue
-                    elif cf and hi > 1.0:  # the same, less the Hermite's error bound
-                        if En < 0.0:
-                            En = energy_norm(MC, mode, y0, z0)
-                        sl = hs * (abs(d0) + abs(d1))
-                        if min(g0, g1) - _HERM_SLOPE * sl - HERM_ERR * (
-                                GB[k, BD_D4] * En + om4 * GB[k, BD_R]) * ((hs * hs) * (hs * hs)
-                                ) > 1e-9 * (abs(g0) + abs(g1) + sl):
+                        err = 0.0
+                        if cf:  # the guard's bound coefficients are those of the mode entry
+                            if En < 0.0:
+                                En = energy_norm(MC, mode, y0, z0)
+                            M4 = GB[k, BD_D4] * En + om4 * GB[k, BD_R]
+                            err = HERM_ERR * M4 * ((hs * hs) * (hs * hs))
+                        if min(g0, g1) - _HERM_SLOPE * sl - err > 1e-9 * (abs(g0) + abs(g1)
+                                                                          + sl):
                             continue
                     b1, b2, b3 = herm_coeffs(g0, d0, g1, d1, hs)
                     r1, r2 = quad_roots01(b1, 2.0 * b2, 3.0 * b3)
@@ -936,15 +927,11 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
                         for q in (r1, r2):
                             if 0.0 < q < 1.0:
                                 hm = min(hm, g0 + q * (b1 + q * (b2 + q * b3)))
-                        if cf:  # the guard's bound coefficients are those of the mode entry
-                            if En < 0.0:
-                                En = energy_norm(MC, mode, y0, z0)
-                            M4 = GB[k, BD_D4] * En + om4 * GB[k, BD_R]
-                        else:
+                        if not cf:  # (on a closed-form piece M4 is known from above)
                             M4 = _guard_bounds(cf, G, k, n, q2, q3, om, hs, MC, mode, y0, z0,
                                                BD)[2]
-                        if not (hm > HERM_ERR * M4 * ((hs * hs) * (hs * hs)) or _herm_clear(g0, d0, g1, d1, hs,
-                                                                         M4)):
+                        if not (hm > HERM_ERR * M4 * ((hs * hs) * (hs * hs))
+                                or _herm_clear(g0, d0, g1, d1, hs, M4)):
                             hi, ghi = _scan_step(cf, g0, d0, g1, d1, u, f0, u1, f1, C, S, C1, S1,
                                                  G, k, n, q0, q1, q2, q3, om, hs, MC, mode, y0,
                                                  z0, MF[mode], stack, BD)
