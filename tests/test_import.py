@@ -6,6 +6,8 @@ import subprocess
 import sys
 from pathlib import Path
 
+import pytest
+
 import nonsmooth as ns
 
 HEAVY = ("numba", "xarray", "matplotlib", "scipy")
@@ -77,19 +79,30 @@ def test_python_dash_m_nonsmooth():
     assert r.returncode == 0 and r.stdout.strip() == f"nonsmooth {ns.__version__}"
 
 
-def test_numba_cache_of_other_libraries_is_untouched(tmp_path):
+@pytest.mark.parametrize("cache_dir", [None, "numba-cache"])
+def test_numba_cache_of_other_libraries_is_untouched(tmp_path, cache_dir):
     # another numba library, imported after nonsmooth's kernels: numba's own CACHE_DIR and
-    # locators (its __pycache__ beside the source) still apply to it
+    # locators still apply to it (its __pycache__ beside the source, or NUMBA_CACHE_DIR when the
+    # user set one)
     (tmp_path / "otherlib.py").write_text(
         "import numba\n@numba.njit(cache=True)\ndef f(x):\n    return x + 1\n")
     code = ("import numba\nbefore = numba.config.CACHE_DIR\n"
             "import nonsmooth.integrate, nonsmooth.models, nonsmooth.analysis\n"
             "import otherlib\nassert otherlib.f(1) == 2\n"
             "assert numba.config.CACHE_DIR == before, numba.config.CACHE_DIR")
+    env = {k: v for k, v in os.environ.items() if k != "NUMBA_CACHE_DIR"}
+    env["PYTHONPATH"] = str(tmp_path)
+    where = tmp_path / "__pycache__"
+    if cache_dir:
+        where = tmp_path / cache_dir
+        env["NUMBA_CACHE_DIR"] = str(where)
     r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300,
-                       cwd=tmp_path, env={**os.environ, "PYTHONPATH": str(tmp_path)})
+                       cwd=tmp_path, env=env)
     assert r.returncode == 0, r.stderr
-    assert list((tmp_path / "__pycache__").glob("otherlib.f-*.nbi"))
+    assert list(where.rglob("otherlib.f-*.nbi"))
+    if cache_dir:
+        assert not (tmp_path / "__pycache__").exists() or not list(
+            (tmp_path / "__pycache__").glob("otherlib.f-*.nbi"))
 
 
 def test_source_digest_covers_the_kernels_only(tmp_path):
