@@ -60,7 +60,7 @@ def test_a_branch_without_special_points(tmp_path, capsys):
     (["--bounds", "0.6", "1.6"], "bounds: 0.6 ... 1.6 exclude the start omega = 0.5"),
     (["--bounds", "1.6", "0.5"], "bounds: empty or reversed range"),
     (["--bounds", "nan", "1"], "bounds: expected numbers"),
-    (["--param", "nope"], "nope: unknown parameter"),
+    (["--param", "nope"], "nope: not a parameter of model 'support'"),
     (["--direction", "left"], "direction: expected 'up' or 'down'"),
     (["--k", "0"], "k: must be >= 1"),
     (["--max-points", "1"], "max_points: must be >= 2"),

@@ -63,7 +63,7 @@ def test_simulate_another_builtin_model(tmp_path):
 
 
 @pytest.mark.parametrize("args, needle", [
-    (["--model", "support", "--set", "mu_s=1"], "mu_s: unknown parameter"),
+    (["--model", "support", "--set", "mu_s=1"], "mu_s: not a parameter of model 'support' (a parameter of stick_slip)"),
     (["--model", "stick_slip", "--set", "omega_s=1"], "omega_s: not a parameter of model "
                                                       "'stick_slip'"),
     (["--model", "nosuch"], "model: unknown model 'nosuch'"),
@@ -80,7 +80,7 @@ def test_model_errors_are_one_line_exit_2(args, needle, tmp_path):
 
 def test_support_parameter_of_another_model_names_it(tmp_path):
     r = _cli("simulate", "--set", "mu_s=1", "--periods", "1", "-o", "x.nc", cwd=tmp_path)
-    _one_error_line(r, "mu_s: unknown parameter")
+    _one_error_line(r, "mu_s: not a parameter of model 'support' (a parameter of stick_slip)")
     assert "stick_slip" in r.stderr
 
 

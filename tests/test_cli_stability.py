@@ -72,11 +72,11 @@ def test_orbit_on_another_model_with_complex_multipliers(capsys):
     (["orbit", "--k", "0"], "k: must be >= 1"),
     (["orbit", "--max-iter", "0"], "max_iter: must be >= 1"),
     (["orbit", "--tol", "0"], "tol: must be > 0"),
-    (["orbit", "--set", "nope=1"], "nope: unknown parameter"),
+    (["orbit", "--set", "nope=1"], "nope: not a parameter of model 'support'"),
     (["orbit", "--model", "impact", "--method", "rk4"], "method: model 'impact' has no method"),
     (["lyapunov", "--periods", "0"], "periods: must be >= 1"),
     (["lyapunov", "--blocks", "1"], "blocks: must be >= 2"),
-    (["lyapunov", "--set", "nope=1"], "nope: unknown parameter"),
+    (["lyapunov", "--set", "nope=1"], "nope: not a parameter of model 'support'"),
     (["lyapunov", "--model", "stick_slip", "--set", "omega_s=1"], "omega_s: not a parameter"),
     (["lyapunov", "--x0", "nan"], "x0: must be finite"),
 ])

@@ -12,7 +12,7 @@ from nonsmooth.models.support.smooth_kernel import fixed_step
 from nonsmooth.models.support import switch as sw
 from oracles import linear_solution, steady_amplitude
 
-FREE = ns.Params(omega0=1.0, omega_s=10.0, xi=0.05, xi_s=0.3, F0=0.05, omega=0.8, eta=1e-4)
+FREE = ns.model("support").params(omega0=1.0, omega_s=10.0, xi=0.05, xi_s=0.3, F0=0.05, omega=0.8, eta=1e-4)
 
 
 # ---------------------------------------------------------------- tableau identities
@@ -81,7 +81,7 @@ def test_error_proportional_to_tolerance(rtol):
 
 def test_contact_phase_matches_closed_form():
     """Deep in Gamma+ (stiff support), the solution is the closed form of eq. 4 (contact)."""
-    p = ns.Params(omega0=1.0, omega_s=5.0, xi=0.05, xi_s=0.1, F0=0.3, omega=0.9, eta=1e-5)
+    p = ns.model("support").params(omega0=1.0, omega_s=5.0, xi=0.05, xi_s=0.1, F0=0.3, omega=0.9, eta=1e-5)
     # start well inside contact, pushing into the support, and watch a short time window
     X0, V0 = 1.3, 0.5
     ds = ns.simulate(p, periods=1, samples_per_period=4000, x0=X0, v0=V0, rtol=1e-11, atol=1e-13)

@@ -17,7 +17,8 @@ import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
-from nonsmooth import Params, Solver, preset
+from nonsmooth import Solver, preset
+from nonsmooth.models.support import MODEL as SUPPORT
 from nonsmooth import status as st
 from nonsmooth.integrate.contract import ST_MODE
 from nonsmooth.models.support.exact_kernel import advance_exact
@@ -37,7 +38,7 @@ def run(params, n_out, per_period=1, n_skip=0, x0=0.0, v0=0.0, mode=-1, method="
     return code, dict(X=X, V=V, R=R, M=M, Xmax=Xmax, Xmin=Xmin, state=state)
 
 
-def reference(p: Params, x0, v0, t_end, rtol=1e-12, atol=1e-12, max_step=0.01):
+def reference(p, x0, v0, t_end, rtol=1e-12, atol=1e-12, max_step=0.01):
     """scipy DOP853 on eqs. 4 / 7-9 with a restart at each switch (same switching rules)."""
     w0, ws, xi, xis, F0, om = p.omega0, p.omega_s, p.xi, p.xi_s, p.F0, p.omega
     r = xis / ws ** 2
@@ -247,7 +248,7 @@ def test_status_codes_for_bad_input():
     code, _ = run(p, 2, x0=float("nan"))
     assert code == st.NON_FINITE
     # undamped free flight forced exactly at resonance: no bounded closed form, its own status
-    q = Params(omega0=1.0, omega_s=10.0, xi=0.0, xi_s=0.3, F0=0.1, omega=1.0)
+    q = SUPPORT.params(omega0=1.0, omega_s=10.0, xi=0.0, xi_s=0.3, F0=0.1, omega=1.0)
     code, _ = run(q, 2)
     assert code == st.RESONANCE
 
@@ -289,7 +290,7 @@ def test_smoothed_model_converges_to_exact_as_eta_shrinks():
                                      (2.0, 2.0 * math.sqrt(10.0) - 2.0),  # critical contact
                                      (3.0, 0.5)])                        # overdamped free flight
 def test_critically_and_overdamped_modes_match_scipy(xi, xi_s):
-    p = Params(omega0=1.0, omega_s=3.0, xi=xi, xi_s=xi_s, F0=5.0, omega=1.0)
+    p = SUPPORT.params(omega0=1.0, omega_s=3.0, xi=xi, xi_s=xi_s, F0=5.0, omega=1.0)
     code, out = run(p, 10)
     assert code == st.OK
     Xr, Vr, n_contacts = reference(p, 0.0, 0.0, 10 * p.period)
@@ -303,7 +304,7 @@ def test_degenerate_corner_starts_end_with_a_status(F0, xi_s):
     # X = 1, V = 0 with X'' = 0 (or 1e-12) at t = 0: both switching surfaces and the field's
     # first derivatives vanish together. Must end quickly with a status, never hang.
     import time
-    p = Params(omega0=1.0, omega_s=17.32, xi=0.0, xi_s=xi_s, F0=F0, omega=0.92)
+    p = SUPPORT.params(omega0=1.0, omega_s=17.32, xi=0.0, xi_s=xi_s, F0=F0, omega=0.92)
     t0 = time.perf_counter()
     code, out = run(p, 4, per_period=4, x0=1.0, v0=0.0)
     assert time.perf_counter() - t0 < 5.0

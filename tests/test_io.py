@@ -153,13 +153,13 @@ def test_from_attrs_refuses_a_swept_parameter_left_at_its_base_value():
     ds = xr.Dataset(coords={"omega": [0.8, 0.9, 1.0]}, attrs=p.attrs())
     # before the fix: the base omega of the attrs came back silently
     with pytest.raises(ns.ParameterError) as exc:
-        ns.Params.from_attrs(ds)
+        ns.model("support").params_from_attrs(ds)
     assert str(exc.value).startswith("omega: swept in this dataset")
-    assert ns.Params.from_attrs(ds, omega=0.9) == p.replace(omega=0.9)
-    assert ns.Params.from_attrs(p.attrs()) == p
+    assert ns.model("support").params_from_attrs(ds, omega=0.9) == p.replace(omega=0.9)
+    assert ns.model("support").params_from_attrs(p.attrs()) == p
     attrs = io.provenance_attrs(p, swept=("omega",))
     assert "param_omega" not in attrs and attrs["param_F0"] == p.F0
     with pytest.raises(ns.ParameterError, match="^omega: no param_omega attribute"):
-        ns.Params.from_attrs(attrs)
-    with pytest.raises(ns.ParameterError, match="^nope: unknown parameter"):
-        ns.Params.from_attrs(ds, nope=1.0)
+        ns.model("support").params_from_attrs(attrs)
+    with pytest.raises(ns.ParameterError, match="^nope: not a parameter of model 'support'"):
+        ns.model("support").params_from_attrs(ds, nope=1.0)

@@ -20,7 +20,7 @@ from nonsmooth import status as st  # noqa: E402
 from nonsmooth.errors import ParameterError  # noqa: E402
 from nonsmooth.kernels import Solver, advance, new_state, output_buffers, run  # noqa: E402
 from nonsmooth.models import model  # noqa: E402
-from nonsmooth.params import Params  # noqa: E402
+from nonsmooth.models.support import MODEL as SUPPORT  # noqa: E402
 
 pytestmark = pytest.mark.filterwarnings("ignore::numba.NumbaExperimentalFeatureWarning")
 
@@ -43,7 +43,7 @@ def trajectory(solver, p, n_out, per_period=1, x0=0.0, v0=0.0):
 @pytest.mark.parametrize("method", ["exact", "smooth"])
 def test_far_left_support_is_the_support_model(method):
     n = 50
-    ps = Params(omega0=1.0, omega_s=17.32, xi=0.05, xi_s=0.6, F0=0.3125, omega=OMEGA_A,
+    ps = SUPPORT.params(omega0=1.0, omega_s=17.32, xi=0.05, xi_s=0.6, F0=0.3125, omega=OMEGA_A,
                 eta=1e-5)
     s1 = Solver(model="support", method=method, **SOLVERS[method])
     # settle on the period-1 orbit with the support model's specialised kernel (kernels.advance

@@ -44,7 +44,8 @@ def test_models_lists_the_builtins_and_model_returns_them():
     for name in BUILTIN:
         m = ns.model(name)
         assert m.name == name and m.description and m.parameters
-        assert set(m.methods) == {"smooth", "exact"}
+        assert set(m.methods) == ({"smooth", "smooth_eq12", "exact"} if name == "support"
+                                  else {"smooth", "exact"})
         assert m.omega in m.param_names
         assert m.summary()["name"] == name
         for p in m.parameters:  # every parameter has a range text and units
@@ -54,7 +55,21 @@ def test_models_lists_the_builtins_and_model_returns_them():
 def test_preset_keeps_returning_the_papers_sets_of_the_support_model():
     p = ns.preset("table3")
     assert p.model is ns.model("support")
-    assert isinstance(p, ns.Params) and p.omega == 0.91
+    assert isinstance(p, ns.models.ModelParams) and p.omega == 0.91
+
+
+def test_params_is_a_deprecated_alias_of_the_support_models_params():
+    with pytest.warns(DeprecationWarning, match="model\\('support'\\).params"):
+        p = ns.Params(omega0=1.0, omega_s=3.0, xi=0.05, xi_s=0.3, F0=0.1, omega=0.9)
+    assert p == ns.model("support").params(omega0=1.0, omega_s=3.0, xi=0.05, xi_s=0.3, F0=0.1,
+                                           omega=0.9)
+    assert isinstance(p, ns.Params) and not isinstance(ns.model("impact").params(), ns.Params)
+    with pytest.warns(DeprecationWarning):
+        assert ns.Params.from_attrs(p.attrs()) == p
+    with pytest.warns(DeprecationWarning):
+        q = ns.Params.from_dimensional(m=1.0, k=1.0, c=0.05, k_s=9.0, c_s=0.3, f0=0.1, g=1.0,
+                                       omega=0.9)
+    assert q.omega_s == pytest.approx(3.0) and q.eta == pytest.approx(1e-5)
 
 
 @pytest.mark.parametrize("name,method", pairs())
@@ -148,7 +163,7 @@ def test_generic_kernel_reproduces_the_specialised_support_kernels():
     by the generic kernel agrees with the specialised kernels: an independent implementation
     of the same model."""
     p = ns.preset("table3").replace(omega=1.1)  # period 1 with contact every period
-    for method, tol in (("smooth", 1e-7), ("exact", 1e-9)):
+    for method, tol in (("smooth", 1e-7), ("smooth_eq12", 1e-7), ("exact", 1e-9)):
         s = Solver(model="support", method=method, rtol=1e-10, atol=1e-12)
         out = {}
         for code in (s.code, 2):

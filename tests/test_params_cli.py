@@ -11,11 +11,12 @@ from hypothesis import strategies as st
 
 import nonsmooth as ns
 from nonsmooth.io import load_dataset, save_dataset
+from nonsmooth.models.support import from_dimensional
 
 VALID = dict(omega0=1.0, omega_s=3.0, xi=0.05, xi_s=0.3, F0=0.1, omega=0.9, eta=1e-5)
 
 
-# ---------------------------------------------------------------- Params
+# ---------------------------------------------------------------- the support model's parameters
 @pytest.mark.parametrize("field, value", [
     ("omega0", 0.0), ("omega0", -1.0), ("omega_s", -1.0), ("xi", -0.1), ("xi_s", -0.1),
     ("omega", 0.0), ("eta", 0.0), ("eta", -1.0), ("eta", 0.5), ("F0", math.nan),
@@ -23,15 +24,15 @@ VALID = dict(omega0=1.0, omega_s=3.0, xi=0.05, xi_s=0.3, F0=0.1, omega=0.9, eta=
 ])
 def test_invalid_parameter_names_the_field(field, value):
     with pytest.raises(ns.ParameterError) as exc:
-        ns.Params(**{**VALID, field: value})
+        ns.model("support").params(**{**VALID, field: value})
     msg = str(exc.value)
     assert msg.startswith(f"{field}:") and "\n" not in msg
 
 
 def test_replace_validates_and_rejects_unknown_names():
-    p = ns.Params(**VALID)
+    p = ns.model("support").params(**VALID)
     assert p.replace(omega=1.2).omega == 1.2 and p.omega == 0.9  # immutable
-    with pytest.raises(ns.ParameterError, match="^nope: unknown parameter"):
+    with pytest.raises(ns.ParameterError, match="^nope: not a parameter of model 'support'"):
         p.replace(nope=1)
     with pytest.raises(ns.ParameterError, match="^eta:"):
         p.replace(eta=-1)
@@ -40,20 +41,20 @@ def test_replace_validates_and_rejects_unknown_names():
 
 
 def test_support_without_stiffness_needs_no_damping():
-    ns.Params(**{**VALID, "omega_s": 0.0, "xi_s": 0.0})
+    ns.model("support").params(**{**VALID, "omega_s": 0.0, "xi_s": 0.0})
     with pytest.raises(ns.ParameterError, match="^omega_s:"):
-        ns.Params(**{**VALID, "omega_s": 0.0})
+        ns.model("support").params(**{**VALID, "omega_s": 0.0})
 
 
 def test_from_dimensional_follows_eq3():
     m, k, c, ks, cs, f0, g = 2.0, 8.0, 0.4, 50.0, 1.0, 3.0, 0.01
-    p = ns.Params.from_dimensional(m=m, k=k, c=c, k_s=ks, c_s=cs, f0=f0, g=g, omega=1.5,
+    p = from_dimensional(m=m, k=k, c=c, k_s=ks, c_s=cs, f0=f0, g=g, omega=1.5,
                                    eta_hat=1e-5)
     assert p.omega0 == pytest.approx(2.0) and p.omega_s == pytest.approx(5.0)
     assert p.xi == pytest.approx(0.2) and p.xi_s == pytest.approx(0.5)
     assert p.F0 == pytest.approx(f0 / (m * g)) and p.eta == pytest.approx(1e-3)
     with pytest.raises(ns.ParameterError, match="^g:"):
-        ns.Params.from_dimensional(m=m, k=k, c=c, k_s=ks, c_s=cs, f0=f0, g=0.0, omega=1.0)
+        from_dimensional(m=m, k=k, c=c, k_s=ks, c_s=cs, f0=f0, g=0.0, omega=1.0)
 
 
 @settings(max_examples=60, deadline=None)
@@ -62,10 +63,10 @@ def test_from_dimensional_follows_eq3():
 def test_valid_parameters_round_trip_through_pack_and_attrs(w0, ws, xi, xis, F0, om, eta):
     if ws == 0.0:
         xis = 0.0
-    p = ns.Params(omega0=w0, omega_s=ws, xi=xi, xi_s=xis, F0=F0, omega=om, eta=eta)
+    p = ns.model("support").params(omega0=w0, omega_s=ws, xi=xi, xi_s=xis, F0=F0, omega=om, eta=eta)
     packed = p.pack()
     assert packed.dtype == np.float64 and list(packed) == [getattr(p, n) for n in ns.PARAM_NAMES]
-    assert ns.Params.from_attrs(p.attrs()) == p
+    assert ns.model("support").params_from_attrs(p.attrs()) == p
 
 
 def test_presets_match_the_paper_tables():
@@ -94,10 +95,10 @@ def test_simulate_dataset_layout_and_provenance(tmp_path):
     assert ds.region.dtype == np.int8 and "flag_meanings" in ds.region.attrs
     assert ds.attrs["nonsmooth_version"] == ns.__version__
     assert ds.attrs["method"] == "smooth" and ds.attrs["rtol"] == 1e-8
-    assert ns.Params.from_attrs(ds.attrs) == p
+    assert ns.model("support").params_from_attrs(ds.attrs) == p
     back = load_dataset(save_dataset(ds, tmp_path / "s.nc"))
     np.testing.assert_array_equal(back.X.values, ds.X.values)
-    assert ns.Params.from_attrs(back.attrs) == p
+    assert ns.model("support").params_from_attrs(back.attrs) == p
 
 
 def test_simulate_rejects_bad_arguments():
@@ -105,7 +106,7 @@ def test_simulate_rejects_bad_arguments():
     for kw, field in ((dict(periods=0), "periods"), (dict(periods=1, transient=-1), "transient"),
                       (dict(periods=1, samples_per_period=0), "samples_per_period"),
                       (dict(periods=1, x0=math.nan), "x0"), (dict(periods=1, method="rk4"), "method"),
-                      (dict(periods=1, rtol=0.0), "rtol"), (dict(periods=1, transition="x"), "transition")):
+                      (dict(periods=1, rtol=0.0), "rtol")):
         with pytest.raises(ns.ParameterError, match=f"^{field}:"):
             ns.simulate(p, **kw)
 
@@ -128,7 +129,7 @@ def _cli(*args, cwd=None):
 @pytest.mark.parametrize("args, needle", [
     (["--set", "eta=-1"], "eta:"),
     (["--set", "omega=nan"], "omega:"),
-    (["--set", "nope=1"], "nope: unknown parameter"),
+    (["--set", "nope=1"], "nope: not a parameter of model 'support'"),
     (["--set", "omega"], "expected NAME=VALUE"),
     (["--preset", "missing"], "preset: unknown preset"),
     (["--periods", "0"], "periods:"),
@@ -145,6 +146,23 @@ def test_simulate_bad_input_one_line_nonzero_no_traceback(args, needle, tmp_path
     lines = [ln for ln in r.stderr.splitlines() if ln.strip()]
     assert len(lines) == 1 and lines[0].startswith("error: ") and needle in lines[0]
     assert not (tmp_path / "x.nc").exists()
+
+
+def test_eq12_is_a_method_of_the_support_model(tmp_path):
+    """The eq. 12 variant is ``--method smooth_eq12`` (it was ``--transition eq12``): the same
+    numbers from the CLI and from the library, and different ones from eq. 13."""
+    r = _cli("simulate", "--preset", "table1", "--method", "smooth_eq12", "--periods", "2",
+             "--transient", "5", "-o", str(tmp_path / "t.nc"))
+    assert r.returncode == 0, r.stderr
+    ds = load_dataset(tmp_path / "t.nc")
+    assert ds.attrs["method"] == "smooth_eq12"
+    p = ns.preset("table1")
+    lib = ns.simulate(p, periods=2, transient=5, method="smooth_eq12")
+    np.testing.assert_array_equal(ds.X.values, lib.X.values)
+    eq13 = ns.simulate(p, periods=2, transient=5)
+    assert np.max(np.abs(eq13.X.values - lib.X.values)) > 1e-6
+    r = _cli("simulate", "--transition", "eq12", "-o", str(tmp_path / "u.nc"))
+    assert r.returncode == 2 and "Traceback" not in r.stderr + r.stdout
 
 
 def test_simulate_command_writes_netcdf_and_png(tmp_path):

@@ -102,7 +102,7 @@ def test_bifurcation_uses_the_model(results, name, method):
 
 def test_model_helpers():
     assert model_of({}).name == "support"  # files written before the model attribute
-    assert mode_labels(ns.model("support")) == REGION_LABELS
+    assert mode_labels(ns.model("support")) == REGION_LABELS == ns.model("support").mode_labels
     assert mode_labels(ns.model("stick_slip")) == ns.model("stick_slip").mode_names
     p = ns.model("stick_slip").params()
     attrs = p.attrs()

@@ -51,7 +51,7 @@ def test_fig3_eq12_evidence_prints_true_maxima(fig345):
                                              line)[0])
     p = ns.preset("table1")
     assert m13 == pytest.approx(_dense_max(p, 2, 10), abs=2e-6)
-    assert m12 == pytest.approx(_dense_max(p, 2, 10, transition="eq12"), abs=2e-6)
+    assert m12 == pytest.approx(_dense_max(p, 2, 10, method="smooth_eq12"), abs=2e-6)
     assert abs(m13 - m12) < 1e-4  # the sampled maxima differed by 4e-3
 
 

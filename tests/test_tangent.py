@@ -96,6 +96,7 @@ IMPACT_ORBIT = dict(omega0=1.0, xi=0.05, F0=3.0, omega=1.5, r=0.8)  # one impact
 CASES = [
     ("support", "exact", ns.preset("table3").replace(omega=0.92), 50, 3, 3, {0, 3}),
     ("support", "smooth", ns.preset("table3").replace(omega=0.92), 50, 3, 3, {0, 1, 2, 3}),
+    ("support", "smooth_eq12", ns.preset("table3").replace(omega=0.92), 50, 3, 3, {0, 1, 2, 3}),
     ("impact", "exact", ns.model("impact").params(**IMPACT_ORBIT), 200, 3, 3, {0}),
     # k_c = 1e3: a softer contact keeps the FD noise of the step-size controller (which the
     # tangent, the derivative of the discrete step at fixed h, does not see) well below 1e-6

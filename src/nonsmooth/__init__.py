@@ -1,7 +1,8 @@
 """nonsmooth: nonlinear dynamics of non-smooth mechanical systems.
 
-Public API: :func:`models`, :func:`model` (a model's ``params(...)``), :class:`Params` (the
-paper's model), :func:`preset`, :func:`simulate`, and the analyses.
+Public API: :func:`models`, :func:`model` (a model's ``params(...)``), :func:`preset` (the
+paper's parameter sets of the ``support`` model), :func:`simulate`, and the analyses.
+``Params`` is a deprecated alias of ``model("support").params``.
 
 Importing the package is cheap and has no side effects: the public names are loaded on first
 use (PEP 562), so numba, xarray, scipy and matplotlib are imported, and the kernels compiled or
@@ -19,8 +20,8 @@ from .errors import IntegrationError, NonsmoothError, OutputError, ParameterErro
 
 #: Public name -> module (relative to this package) that defines it.
 _LAZY = {
-    "Params": ".params", "PARAM_NAMES": ".params",
-    "preset": ".presets", "PRESETS": ".presets",
+    "Params": ".models.support", "PARAM_NAMES": ".models.support",
+    "preset": ".models.support", "PRESETS": ".models.support",
     "Solver": ".kernels",
     "model": ".models",
     "simulate": ".simulate",
@@ -38,8 +39,8 @@ _LAZY = {
 }
 
 #: Subpackages and modules reachable as attributes (``ns.io``, ``ns.plot``, ...).
-_SUBMODULES = ("analysis", "cli", "errors", "integrate", "io", "kernels", "models", "params",
-               "plot", "presets", "reproduction", "status", "sweep", "chunks")
+_SUBMODULES = ("analysis", "cli", "errors", "integrate", "io", "kernels", "models",
+               "plot", "reproduction", "status", "sweep", "chunks")
 
 __all__ = ["__version__", "Params", "PARAM_NAMES", "model", "models", "preset", "PRESETS", "simulate", "reproduce", "Solver",
            "eta_study", "lyapunov", "periodic_orbit", "continuation", "two_parameter_curve", "parameter_map", "poincare", "bifurcation_diagram", "resonance_curve", "basins",

@@ -24,8 +24,7 @@ ROOT = Path(__file__).resolve().parent
 
 #: Sources whose compiled code (or constants read by compiled code) the kernels depend on:
 #: every package module with numba code must be listed here (a test checks it).
-KERNEL_SOURCES = ("integrate", "models", "analysis", "kernels.py", "sweep.py", "status.py",
-                  "params.py")
+KERNEL_SOURCES = ("integrate", "models", "analysis", "kernels.py", "sweep.py", "status.py")
 
 _digest: str | None = None
 _base: Path | None = None

@@ -51,7 +51,7 @@ def status_flags(**extra) -> dict:
 def provenance_attrs(params=None, solver=None, swept=(), **extra) -> dict:
     """Flat, netCDF-safe attrs: ``Conventions``, ``param_*`` for the parameters except the
     ``swept`` ones (coordinates of the result: a base value in the attrs would be read back as
-    the point, see ``Params.from_attrs``), the solver settings, the package version and any
+    the point, see ``Model.params_from_attrs``), the solver settings, the package version and any
     ``extra`` (bools become 0/1, None becomes "")."""
     import numba
     import scipy

@@ -33,18 +33,18 @@ from .integrate.contract import (
     OPT_NMEM,
     OPT_OMEGA,
     OPT_RTOL,
-    OPT_TRANSITION,
+    OPT_VARIANT,
     ST_EXTRA,
     ST_MODE,
     ST_V,
     ST_X,
 )
 from .integrate.hybrid import advance_generic
-from .models.base import KERNEL_GENERIC, KERNEL_SUPPORT_EXACT, KERNEL_SUPPORT_SMOOTH
+from .models.base import DEFAULT_MODEL, KERNEL_GENERIC, KERNEL_SUPPORT_EXACT, KERNEL_SUPPORT_SMOOTH
 from .models.support.exact_kernel import advance_exact
 from .models.support.smooth_kernel import advance_smooth
-from .models.support.switch import TRANSITIONS, beta_ratio, inside_margin
-from .params import IDX
+from .models.support.switch import beta_ratio, inside_margin
+from .models.support.parameters import IDX
 
 _I_OMEGA_S = IDX["omega_s"]
 _I_XI_S = IDX["xi_s"]
@@ -115,27 +115,20 @@ def advance(method, p, opts, state, per_period, n_skip, n_out, X, V, R, M, Xmax,
 @dataclass(frozen=True)
 class Solver:
     """How trajectories of ``model`` (default: the paper's ``support``) are computed:
-    ``method`` "smooth" (switch model, RKF45) or "exact" (non-smooth, event-driven);
-    tolerances; ``transition`` "eq13" (paper) or "eq12" (convex combinations; support model
-    only); ``max_steps`` per forcing period before giving up."""
+    ``method`` one of the model's methods ("smooth": a switch model, RKF45; "exact":
+    non-smooth, event-driven; support also has "smooth_eq12"); tolerances; ``max_steps`` per
+    forcing period before giving up."""
 
     method: str = "smooth"
     rtol: float = 1e-8
     atol: float = 1e-10
-    transition: str = "eq13"
     max_steps: int = 200_000
     model: object = None
 
     def __post_init__(self):
         from .models import model as get_model
-        object.__setattr__(self, "model", get_model(self.model or "support"))
+        object.__setattr__(self, "model", get_model(self.model or DEFAULT_MODEL))
         self.model.method(self.method)  # one-line error for an unknown method
-        if self.transition != "eq13" and self.model.name != "support":
-            raise ParameterError(f"transition: only the support model has the eq12/eq13 "
-                                 f"variants (model {self.model.name!r})")
-        if self.transition not in TRANSITIONS:
-            raise ParameterError(
-                f"transition: unknown transition {self.transition!r} (known: {', '.join(TRANSITIONS)})")
         for name in ("rtol", "atol"):
             v = getattr(self, name)
             if not (isinstance(v, (int, float)) and math.isfinite(v) and 0 < v < 1):
@@ -174,7 +167,7 @@ class Solver:
         o[OPT_RTOL] = self.rtol if m.rtol is None else min(self.rtol, m.rtol)
         o[OPT_ATOL] = self.atol if m.atol is None else min(self.atol, m.atol)
         o[OPT_MAX_STEPS] = self.max_steps
-        o[OPT_TRANSITION] = TRANSITIONS[self.transition]
+        o[OPT_VARIANT] = m.variant
         o[OPT_OMEGA] = self.model.index[self.model.omega]
         o[OPT_N] = self.model.n
         o[OPT_NMEM] = self.model.n_memory
@@ -186,10 +179,9 @@ class Solver:
         o = self.opts()
         a = {"model": self.model.name, "method": self.method, "rtol": float(o[OPT_RTOL]),
              "atol": float(o[OPT_ATOL]), "max_steps_per_period": int(self.max_steps)}
-        if self.model.name == "support" and self.method == "smooth":
-            a["transition"] = self.transition
+        if m.kernel == KERNEL_SUPPORT_SMOOTH:
             a["integrator"] = smooth_integrator()
-        elif self.model.name == "support":
+        elif m.kernel == KERNEL_SUPPORT_EXACT:
             a["integrator"] = "closed form between located switching events"
         else:
             a["integrator"] = m.description or generic_integrator(m.closed_form)

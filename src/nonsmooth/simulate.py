@@ -39,21 +39,21 @@ def check_float(name: str, value) -> float:
 
 
 def check_params(params) -> ParamsBase:
-    """``params`` if it is a model's validated parameters (``nonsmooth.Params`` or
-    ``model.params(...)``), else a one-line ParameterError."""
+    """``params`` if it is a model's validated parameters (``model(...).params(...)``,
+    ``preset(...)``), else a one-line ParameterError."""
     if not isinstance(params, ParamsBase):
-        raise ParameterError(f"params: expected nonsmooth.Params or model(...).params(...), "
+        raise ParameterError(f"params: expected model(...).params(...) or preset(...), "
                              f"got {type(params).__name__}")
     return params
 
 
-def start_trajectory(params, x0, v0, method, rtol, atol, transition):
+def start_trajectory(params, x0, v0, method, rtol, atol):
     """Validated single-trajectory set-up: (params, solver, packed params, kernel opts, initial
     kernel state). Every error names its field."""
     params = check_params(params)
     x0 = check_float("x0", x0)
     v0 = check_float("v0", v0)
-    solver = Solver(method=method, rtol=rtol, atol=atol, transition=transition,
+    solver = Solver(method=method, rtol=rtol, atol=atol,
                     model=params.model)
     return params, solver, params.pack(), solver.opts(), new_state(x0, v0)
 
@@ -88,10 +88,10 @@ SAMPLES_PER_PERIOD = 200
 _SAMPLE_BYTES = 5 * 8 + 2
 
 
-def simulate(params: Params, *, periods: int, transient: int = 0,
+def simulate(params: ParamsBase, *, periods: int, transient: int = 0,
              samples_per_period: int = SAMPLES_PER_PERIOD, x0: float = 0.0, v0: float = 0.0,
              method: str = "smooth", rtol: float = 1e-8, atol: float = 1e-10,
-             transition: str = "eq13", progress=None) -> xr.Dataset:
+             progress=None) -> xr.Dataset:
     """Integrate one trajectory from (x0, v0) at t = 0 (forcing phase 0).
 
     After ``transient`` whole forcing periods T = 2 pi/omega, the state is sampled at
@@ -114,8 +114,7 @@ def simulate(params: Params, *, periods: int, transient: int = 0,
     progress = progress_callback(progress, "simulate")
     from .io import check_memory, flag_attrs, format_bytes
     from .sweep import run_trajectories
-    params, solver, p, opts, state = start_trajectory(params, x0, v0, method, rtol, atol,
-                                                      transition)
+    params, solver, p, opts, state = start_trajectory(params, x0, v0, method, rtol, atol)
     periods = check_int("periods", periods, 1)
     transient = check_int("transient", transient, 0)
     spp = check_int("samples_per_period", samples_per_period, 1)

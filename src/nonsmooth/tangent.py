@@ -25,9 +25,6 @@ class TangentSetup:
 
     def __init__(self, solver: Solver):
         m = solver.model
-        if m.name == "support" and solver.method == "smooth" and solver.transition != "eq13":
-            raise ParameterError("transition: tangent dynamics (lyapunov, periodic_orbit) of the "
-                                 "smoothed support model follow eq. 13 only (transition='eq13')")
         self.solver = solver
         self.model = m
         self.fns = solver.fns

@@ -25,7 +25,6 @@ from ..io import provenance_attrs
 from ..integrate.contract import MODEL_FNS_TYPE
 from ..kernels import Solver, mode_holds, run
 from ..models.base import ParamsBase
-from ..params import check_param_name
 from ..sweep import parallel_chunks
 from .poincare import (MAX_PERIOD, PERIOD_LONG_NAME, SETTLE_WINDOW, classify_many, settle,
                        settle_tolerance)
@@ -136,8 +135,9 @@ def check_values(name: str, values) -> np.ndarray:
 
 
 def param_rows(params: ParamsBase, param: str, values) -> np.ndarray:
-    """Packed parameters, one row per value. Every constraint of Params is an interval in
-    each parameter, so validating the smallest and the largest value validates them all."""
+    """Packed parameters, one row per value. A parameter's allowed values are an interval (and
+    a model's cross-field rule holds on an interval of each parameter, as support's omega_s = 0
+    needs xi_s = 0), so validating the smallest and the largest value validates them all."""
     values = np.asarray(values, dtype=np.float64)
     for x in (values.min(), values.max()):
         params.replace(**{param: float(x)})
@@ -491,12 +491,13 @@ class _LazyParams:
 def bifurcation_diagram(params: ParamsBase, param: str, values, *, sweep: str = "both",
                         transient: int = 500, record: int = 200, method: str = "smooth",
                         x0: float = 0.0, v0: float = 0.0, rtol: float = 1e-8,
-                        atol: float = 1e-10, transition: str = "eq13", settle: bool = True,
+                        atol: float = 1e-10, settle: bool = True,
                         max_steps: int = 200_000, workers: int | None = None,
                         progress=None, lyapunov: bool | None = None, store=None,
                         engine=None) -> xr.Dataset:
-    """Orbit diagram of the stroboscopic section over ``param`` (any of omega, F0, omega_s,
-    xi, xi_s, omega0, eta) at ``values`` (sorted ascending; each validated by Params).
+    """Orbit diagram of the stroboscopic section over ``param`` (any parameter of the model:
+    omega, F0, omega_s, xi, xi_s, omega0, eta for support) at ``values`` (sorted ascending; each
+    validated by the model).
 
     ``sweep``: "up" / "down" continue the state from value to value in increasing /
     decreasing order, "both" does both (in parallel), "fresh" restarts every value from
@@ -532,7 +533,7 @@ def bifurcation_diagram(params: ParamsBase, param: str, values, *, sweep: str = 
     engine = check_engine(engine)
     if not isinstance(param, str):
         raise ParameterError(f"param: expected a parameter name, got {param!r}")
-    param = check_param_name(param, params)
+    param = params.model.param(param).name
     if sweep not in SWEEPS:
         raise ParameterError(f"sweep: unknown sweep {sweep!r} (known: {', '.join(SWEEPS)})")
     transient = check_int("transient", transient, 0)
@@ -541,7 +542,7 @@ def bifurcation_diagram(params: ParamsBase, param: str, values, *, sweep: str = 
     values = check_values(param, values)
     x0 = check_float("x0", x0)
     v0 = check_float("v0", v0)
-    solver = Solver(model=params.model, method=method, rtol=rtol, atol=atol, transition=transition,
+    solver = Solver(model=params.model, method=method, rtol=rtol, atol=atol,
                     max_steps=max_steps)
     directions = {"up": ["up"], "down": ["down"], "both": ["up", "down"], "fresh": ["fresh"]}[sweep]
     from .stability import wants_lyapunov

@@ -35,7 +35,6 @@ from ..integrate.roots import illinois_point, illinois_update
 from ..io import provenance_attrs
 from ..kernels import output_buffers, run
 from ..models.base import KERNEL_GENERIC
-from ..params import check_param_name
 from ..simulate import check_float, check_int, start_trajectory
 from ..tangent import TangentSetup, period_map
 from .stability import NEUTRAL, _active, _section_state, periodic_orbit
@@ -195,11 +194,10 @@ def continuation(params, param: str, *, start=None, k: int = 1, x0: float = 0.0,
     over ``special`` (``special_type`` with CF flags, ``special_<param>``, the multiplier
     nearest the crossing and the point index after which it lies); attrs ``status`` (why the
     branch ended)."""
-    params, solver, p0, opts, state = start_trajectory(params, x0, v0, method, rtol, atol,
-                                                       "eq13")
+    params, solver, p0, opts, state = start_trajectory(params, x0, v0, method, rtol, atol)
     if not isinstance(param, str):
         raise ParameterError(f"param: expected a parameter name, got {param!r}")
-    param = check_param_name(param, params)
+    param = params.model.param(param).name
     k = check_int("k", k, 1)
     max_points = check_int("max_points", max_points, 2)
     step = check_float("step", step)
@@ -481,7 +479,7 @@ def two_parameter_curve(params, param: str, param2: str, values2, *, special: st
     typ = names[special]
     if not isinstance(param2, str):
         raise ParameterError(f"param2: expected a parameter name, got {param2!r}")
-    param2 = check_param_name(param2, params)
+    param2 = params.model.param(param2).name
     if param2 == param:
         raise ParameterError(f"param2: must differ from param ({param})")
     values2 = np.asarray(values2, dtype=float).ravel()

@@ -2,7 +2,7 @@
 non-smooth dynamics (the paper's Fig. 4 question, answered against the eta = 0 solution).
 
 ``eta_study(params, etas)`` integrates, from the same initial state, the smoothed model
-(``method="smooth"``) for every eta and the exact event-driven model (``method="exact"``)
+(``method="smooth"``, or another smoothed method of the model) for every eta and the exact event-driven model (``method="exact"``)
 once, discards ``transient`` forcing periods and records ``record`` stroboscopic section points
 (t = kT, forcing phase 0) plus an orbit (phase portrait) of ``orbit_periods`` periods.
 
@@ -137,12 +137,12 @@ def _eta_chunk(spec, i, carry, workers=None, progress=None):
 def eta_study(params: ParamsBase, etas, *, transient: int = 300, record: int | None = None,
               orbit_periods: int | None = None, samples_per_period: int = 200, x0: float = 0.0,
               v0: float = 0.0, rtol: float = 1e-8, atol: float = 1e-10,
-              distance_tol: float = 1e-3, transition: str = "eq13",
+              distance_tol: float = 1e-3, method: str = "smooth",
               workers: int | None = None, progress=None, points: int | None = None,
               portrait_periods: int | None = None, store=None, engine=None) -> xr.Dataset:
     """Audit the band half-width eta of the smoothed model against the exact model.
 
-    From (x0, v0), every eta (smoothed model) and the exact model integrate ``transient``
+    From (x0, v0), every eta (smoothed ``method``: "smooth", or support's "smooth_eq12") and the exact model integrate ``transient``
     forcing periods, record ``record`` (default 200; ``points`` is its deprecated name)
     section points and then an orbit of ``orbit_periods`` (default 10; deprecated name
     ``portrait_periods``) periods at ``samples_per_period`` samples per period.
@@ -171,9 +171,15 @@ def eta_study(params: ParamsBase, etas, *, transient: int = 300, record: int | N
     from ..simulate import check_params
     from ..simulate import renamed
     params = check_params(params)
-    if "eta" not in params.model.param_names or set(params.model.methods) != {"smooth", "exact"}:
+    if "eta" not in params.model.param_names or "exact" not in params.model.methods \
+            or "smooth" not in params.model.methods:
         raise ParameterError(f"params: eta_study needs a model with a band eta and both methods "
-                             f"(model {params.model.name!r})")
+                             f"smooth and exact (model {params.model.name!r})")
+    if method == "exact" or method not in params.model.methods:
+        raise ParameterError(f"method: eta_study audits a smoothed method of model "
+                             f"{params.model.name!r} (one of: "
+                             f"{', '.join(k for k in params.model.methods if k != 'exact')}), "
+                             f"got {method!r}")
     full = params.model.contact_modes  # the modes of full contact (support: Gamma+)
     eta_vals = check_etas(etas)
     record = renamed("record", record, "points", points, default=200)
@@ -194,7 +200,7 @@ def eta_study(params: ParamsBase, etas, *, transient: int = 300, record: int | N
     check_memory(34.0 * (n + 1) * (record + orbit_periods * spp), big[1],
                  "record fewer section points, orbit periods or samples per period",
                  size=(big[0], 1))
-    smooth = Solver(method="smooth", rtol=rtol, atol=atol, transition=transition,
+    smooth = Solver(method=method, rtol=rtol, atol=atol,
                     model=params.model)
     exact = Solver(method="exact", model=params.model)
 

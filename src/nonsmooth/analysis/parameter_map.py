@@ -28,7 +28,6 @@ import xarray as xr
 from ..errors import ParameterError
 from ..kernels import Solver
 from ..models.base import ParamsBase
-from ..params import check_param_name
 
 STARTS = ("fresh", "continued")
 #: Points per chunk of a fresh map: at least MAP_CHUNK, and at most MAX_CHUNKS chunks.
@@ -54,7 +53,7 @@ def check_axis(name: str, axis, params: ParamsBase):
         raise ParameterError(f"{name}: expected (parameter, min, max, n), got {axis!r}") from None
     if not isinstance(pname, str):
         raise ParameterError(f"{name}: expected a parameter name first, got {pname!r}")
-    pname = check_param_name(pname, params)
+    pname = params.model.param(pname).name
     lo = check_float(f"{name} min", lo)
     hi = check_float(f"{name} max", hi)
     n = check_int(f"{name} n", n, 1)
@@ -108,7 +107,7 @@ def _map_chunk(spec, i, carry, workers=None, progress=None):
 def parameter_map(params: ParamsBase, x=("omega", 0.8, 1.0, 100), y=("F0", 0.15, 0.45, 100), *,
                   transient: int = 500, record: int = 100, method: str = "smooth",
                   start: str = "fresh", x0: float = 0.0, v0: float = 0.0, rtol: float = 1e-8,
-                  atol: float = 1e-10, transition: str = "eq13", settle: bool = True,
+                  atol: float = 1e-10, settle: bool = True,
                   max_steps: int = 200_000, lyapunov: bool | None = None,
                   workers: int | None = None, progress=None, store=None,
                   engine=None, chunk: int | None = None) -> xr.Dataset:
@@ -158,7 +157,7 @@ def parameter_map(params: ParamsBase, x=("omega", 0.8, 1.0, 100), y=("F0", 0.15,
                  f"a {ny} x {nx} map holds {nx * ny} points; use fewer points per axis",
                  size=(nx, 1))
     solver = Solver(model=params.model, method=method, rtol=rtol, atol=atol,
-                    transition=transition, max_steps=max_steps)
+                    max_steps=max_steps)
     lyap = wants_lyapunov(lyapunov, solver)
     if chunk is not None:
         chunk = check_int("chunk", chunk, 1)

@@ -238,7 +238,7 @@ def classify_many(X, V, Xmax, Xmin, M, rtol: float, atol: float, max_period: int
 
 def poincare(params: ParamsBase, *, record: int | None = None, transient: int, x0: float = 0.0,
              v0: float = 0.0, method: str = "smooth", rtol: float = 1e-8, atol: float = 1e-10,
-             transition: str = "eq13", orbit_samples: int = 200, orbit_periods: int | None = None,
+             orbit_samples: int = 200, orbit_periods: int | None = None,
              settle: bool = False, progress=None, points: int | None = None,
              lyapunov: bool | None = None) -> xr.Dataset:
     """Stroboscopic Poincaré section of one trajectory from (x0, v0) at t = 0.
@@ -272,8 +272,7 @@ def poincare(params: ParamsBase, *, record: int | None = None, transient: int, x
     from ..sweep import run_trajectories
     from .bifurcation import follow, summarize
     record = renamed("record", record, "points", points)
-    params, solver, p, opts, state = start_trajectory(params, x0, v0, method, rtol, atol,
-                                                      transition)
+    params, solver, p, opts, state = start_trajectory(params, x0, v0, method, rtol, atol)
     x0, v0 = float(state[0]), float(state[1])
     record = check_int("record", record, 1)
     transient = check_int("transient", transient, 0)

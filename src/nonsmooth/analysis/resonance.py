@@ -164,7 +164,7 @@ def characteristic_frequencies(params, solver, omegas, out, *, transient, record
 
 def resonance_curve(params: ParamsBase, omegas, *, method: str = "smooth", transient: int = 500,
                     record: int = 50, x0: float = 0.0, v0: float = 0.0, rtol: float = 1e-8,
-                    atol: float = 1e-10, transition: str = "eq13", settle: bool = True,
+                    atol: float = 1e-10, settle: bool = True,
                     resolution: float = 1e-4, branch_tol: float = 1e-3,
                     workers: int | None = None, progress=None,
                     branches: str = "stable", store=None, engine=None) -> xr.Dataset:
@@ -212,7 +212,7 @@ def resonance_curve(params: ParamsBase, omegas, *, method: str = "smooth", trans
         raise ParameterError(f"branch_tol: must be > 0, got {branch_tol}")
     if branches not in ("stable", "all"):
         raise ParameterError(f"branches: expected 'stable' or 'all', got {branches!r}")
-    solver = Solver(method=method, rtol=rtol, atol=atol, transition=transition,
+    solver = Solver(method=method, rtol=rtol, atol=atol,
                     model=params.model)
     out = run_branches(params, w_name, omegas, solver, directions=["up", "down"],
                        transient=transient, record=record, x0=x0, v0=v0, settle=settle,

@@ -109,8 +109,7 @@ def lyapunov(params, *, periods: int = 10000, transient: int = 1000, x0: float =
     """
     from ..sweep import progress_callback
     progress = progress_callback(progress, "lyapunov")
-    params, solver, p, opts, state = start_trajectory(params, x0, v0, method, rtol, atol,
-                                                      "eq13")
+    params, solver, p, opts, state = start_trajectory(params, x0, v0, method, rtol, atol)
     periods = check_int("periods", periods, 1)
     transient = check_int("transient", transient, 0)
     blocks = check_int("blocks", blocks, 2)
@@ -229,8 +228,7 @@ def periodic_orbit(params, *, k: int = 1, x0: float = 0.0, v0: float = 0.0,
     sampled ``samples_per_period`` times a period (so with other steps than Newton's), and is
     reported converged only if it closes on itself to ``CONFIRM_TOL`` (1 + |z|).
     Bad input raises one-line ParameterErrors; a failed search is a status, not an error."""
-    params, solver, p, opts, state = start_trajectory(params, x0, v0, method, rtol, atol,
-                                                      "eq13")
+    params, solver, p, opts, state = start_trajectory(params, x0, v0, method, rtol, atol)
     k = check_int("k", k, 1)
     transient = check_int("transient", transient, 0)
     max_iter = check_int("max_iter", max_iter, 1)
@@ -559,12 +557,8 @@ def motion_attrs() -> dict:
 
 def wants_lyapunov(flag, solver) -> bool:
     """Whether a sweep computes lambda1: ``flag`` True/False, or None (the default) = yes
-    where tangent dynamics exist (all models and methods except the smoothed support model
-    with the eq. 12 transition fields)."""
-    if flag is None:
-        return not (solver.model.name == "support" and solver.method == "smooth"
-                    and solver.transition != "eq13")
-    return bool(flag)
+    (every model and method has tangent dynamics)."""
+    return True if flag is None else bool(flag)
 
 
 def lambda1_evidence(P, solver, states, periods: int, period, *, workers=None):

@@ -9,8 +9,8 @@ import typer
 
 from ..errors import ParameterError
 from .app import app
-from .common import (AtolOpt, DaskOpt, MethodOpt, ModelOpt, OutOpt, PlotOpt, PresetOpt, RtolOpt, SetOpt,
-                     TransitionOpt, WorkersOpt, check_outputs, chunk_store, echo_written, load_params,
+from .common import (DEFAULT_MODEL, AtolOpt, DaskOpt, MethodOpt, ModelOpt, OutOpt, PlotOpt, PresetOpt, RtolOpt, SetOpt,
+                     WorkersOpt, check_outputs, chunk_store, echo_written, load_params,
                      preset_label, require_output, resolve_method, save_outputs)
 
 FromOpt = Annotated[float, typer.Option("--from", help="first value of the range")]
@@ -72,7 +72,7 @@ def _progress(text: str):
 
 @app.command("poincare")
 def poincare_cmd(
-    model: ModelOpt = "support",
+    model: ModelOpt = DEFAULT_MODEL,
     preset: PresetOpt = None,
     set_: SetOpt = None,
     record: Annotated[int, typer.Option("--record", help="section points recorded")] = 2000,
@@ -83,7 +83,6 @@ def poincare_cmd(
     method: MethodOpt = None,
     rtol: RtolOpt = 1e-8,
     atol: AtolOpt = 1e-10,
-    transition: TransitionOpt = "eq13",
     orbit_samples: Annotated[int, typer.Option(help="phase-portrait samples per period")] = 200,
     out: OutOpt = None,
     plot: PlotOpt = None,
@@ -104,7 +103,7 @@ def poincare_cmd(
     check_outputs(out, plot)
     with _progress("poincare") as prog:
         ds = poincare(params, record=record, transient=transient, x0=x0, v0=v0, method=method,
-                      rtol=rtol, atol=atol, transition=transition, orbit_samples=orbit_samples,
+                      rtol=rtol, atol=atol, orbit_samples=orbit_samples,
                       progress=prog)
     from ..plot.poincare import plot_poincare
     save_outputs(ds, preset, out, plot, plot_poincare)
@@ -115,7 +114,7 @@ def poincare_cmd(
 
 @app.command("bifurcation")
 def bifurcation_cmd(
-    model: ModelOpt = "support",
+    model: ModelOpt = DEFAULT_MODEL,
     preset: PresetOpt = None,
     set_: SetOpt = None,
     param: Annotated[Optional[str], typer.Option(
@@ -132,7 +131,6 @@ def bifurcation_cmd(
     method: MethodOpt = None,
     rtol: RtolOpt = 1e-8,
     atol: AtolOpt = 1e-10,
-    transition: TransitionOpt = "eq13",
     settle: SettleOpt = True,
     workers: WorkersOpt = None,
     dask: DaskOpt = None,
@@ -141,13 +139,12 @@ def bifurcation_cmd(
 ):
     """Bifurcation diagram of the section X(kT) over a parameter (Figs. 9 and 11)."""
     from ..analysis.bifurcation import SWEEPS, bifurcation_diagram
-    from ..params import check_param_name
     from ..simulate import check_int
 
     params = load_params(preset, set_, model, "table3", method=method)
     method = resolve_method(params, method)
     preset = preset_label(params, preset, "table3")
-    param = check_param_name(param or params.model.omega, params)
+    param = params.model.param(param or params.model.omega).name
     if sweep not in SWEEPS:
         raise ParameterError(f"sweep: unknown sweep {sweep!r} (known: {', '.join(SWEEPS)})")
     values = value_range(from_, to, steps, f"{param} range", 2 if sweep == "both" else 1,
@@ -162,7 +159,7 @@ def bifurcation_cmd(
     with _progress(f"bifurcation {param} ({sweep})") as prog:
         ds = bifurcation_diagram(params, param, values, sweep=sweep, transient=transient,
                                  record=record, method=method, x0=x0, v0=v0, rtol=rtol,
-                                 atol=atol, transition=transition, settle=settle,
+                                 atol=atol, settle=settle,
                                  workers=workers, progress=prog, store=store, engine=engine)
     from ..plot.bifurcation import plot_bifurcation
     save_outputs(ds, preset, out, plot, plot_bifurcation, store=store)
@@ -173,7 +170,7 @@ def bifurcation_cmd(
 
 @app.command("resonance")
 def resonance_cmd(
-    model: ModelOpt = "support",
+    model: ModelOpt = DEFAULT_MODEL,
     preset: PresetOpt = None,
     set_: SetOpt = None,
     from_: FromOpt = 0.5,
@@ -186,7 +183,6 @@ def resonance_cmd(
     method: MethodOpt = None,
     rtol: RtolOpt = 1e-8,
     atol: AtolOpt = 1e-10,
-    transition: TransitionOpt = "eq13",
     settle: SettleOpt = True,
     resolution: Annotated[float, typer.Option(help="bisection resolution of omega_a/b/c")] = 1e-4,
     all_branches: Annotated[bool, typer.Option(
@@ -216,7 +212,7 @@ def resonance_cmd(
     store, engine = chunk_store(out, dask)
     with _progress("resonance (up and down)") as prog:
         ds = resonance_curve(params, omegas, method=method, transient=transient, record=record,
-                             x0=x0, v0=v0, rtol=rtol, atol=atol, transition=transition,
+                             x0=x0, v0=v0, rtol=rtol, atol=atol,
                              settle=settle, resolution=resolution, workers=workers,
                              progress=prog, branches="all" if all_branches else "stable",
                              store=store, engine=engine)

@@ -8,14 +8,14 @@ from typing import Annotated, Optional
 import typer
 
 from .app import app
-from .common import (AtolOpt, DaskOpt, MethodOpt, ModelOpt, OutOpt, PlotOpt, PresetOpt, RtolOpt, SetOpt,
-                     TransitionOpt, WorkersOpt, check_outputs, chunk_store, echo_written, load_params,
+from .common import (DEFAULT_MODEL, AtolOpt, DaskOpt, MethodOpt, ModelOpt, OutOpt, PlotOpt, PresetOpt, RtolOpt, SetOpt,
+                     WorkersOpt, check_outputs, chunk_store, echo_written, load_params,
                      preset_label, require_output, resolve_method, save_outputs)
 
 
 @app.command("basins")
 def basins_cmd(
-    model: ModelOpt = "support",
+    model: ModelOpt = DEFAULT_MODEL,
     preset: PresetOpt = None,
     set_: SetOpt = None,
     x: Annotated[tuple[float, float], typer.Option("--x", help="range of the initial X: MIN MAX")] = (-3.0, 3.0),
@@ -28,7 +28,6 @@ def basins_cmd(
     method: MethodOpt = None,
     rtol: RtolOpt = 1e-8,
     atol: AtolOpt = 1e-10,
-    transition: TransitionOpt = "eq13",
     workers: WorkersOpt = None,
     dask: DaskOpt = None,
     out: OutOpt = None,
@@ -53,7 +52,7 @@ def basins_cmd(
         warnings.simplefilter("always", UserWarning)
         ds = basins(params, x=x, v=v, grid=grid, method=method, transient=transient,
                     max_periods=max_periods, max_period=max_period, rtol=rtol, atol=atol,
-                    transition=transition, early_stop=not no_early_stop, workers=workers,
+                    early_stop=not no_early_stop, workers=workers,
                     progress=bar, store=store, engine=engine)
     from ..plot.basins import plot_basins
     save_outputs(ds, preset, out, plot, plot_basins, store=store)

@@ -12,6 +12,7 @@ from typing import Annotated, Optional
 import typer
 
 from ..errors import ParameterError
+from .._builtin import DEFAULT_MODEL
 
 PresetOpt = Annotated[Optional[str], typer.Option(
     "--preset", "-p", show_default=False,
@@ -29,11 +30,11 @@ PlotOpt = Annotated[Optional[Path], typer.Option(
 MethodOpt = Annotated[Optional[str], typer.Option(
     "--method", show_default=False,
     help="smooth (switch model, RKF45) or exact (eta = 0; event-driven: --set eta=... is "
-         "accepted and ignored, the exact model has no band); default: smooth, or the model's "
-         "first method if it has no smooth one")]
+         "accepted and ignored, the exact model has no band), or another method of the model "
+         "(support: smooth_eq12, the convex transition fields of eq. 12); default: smooth, or "
+         "the model's first method if it has no smooth one")]
 RtolOpt = Annotated[float, typer.Option("--rtol", help="relative tolerance")]
 AtolOpt = Annotated[float, typer.Option("--atol", help="absolute tolerance")]
-TransitionOpt = Annotated[str, typer.Option("--transition", help="eq13 (paper, default) or eq12 (convex)")]
 WorkersOpt = Annotated[Optional[int], typer.Option("--workers", "-j", help="threads (default: all cores)")]
 DaskOpt = Annotated[Optional[str], typer.Option(
     "--dask", show_default=False,
@@ -53,36 +54,27 @@ def get_model(name: str):
     return model(name)
 
 
-def load_params(preset: str | None, sets: list[str] | None, model: str = "support",
+def load_params(preset: str | None, sets: list[str] | None, model: str = DEFAULT_MODEL,
                 default_preset: str | None = None, method: str | None = None):
-    """The parameters of ``model``: a preset (the paper's for ``support``, where ``None``
-    means ``default_preset``; else one of the model's ``presets``, ``None`` meaning its
-    defaults) with ``--set`` overrides applied. Every error names the field.
+    """The parameters of ``model``: one of its presets (``None``: the command's paper set
+    ``default_preset`` for the default model, the paper's; the model's defaults for any other)
+    with ``--set`` overrides applied. Every error names the field.
 
     With ``method="exact"`` an ``eta`` override (the smoothed model's band) is not applied:
     the exact model has no band, so ``--set eta=0`` is accepted there (the value must still be
     a number) and the preset's eta, unused, stays in the parameters."""
-    from ..params import parse_assignments
-
     m = get_model(model)
     if method == "exact" and "exact" in m.methods and "eta" in m.param_names:
         sets = _without_eta(sets)
-    if m.name == "support" and m.source == "built-in":
-        from ..presets import preset as get_preset
-        base = get_preset(preset or default_preset or "table1")
-        try:
-            values = parse_assignments(sets)
-        except ParameterError as exc:
-            name = str(exc).partition(":")[0]
-            other = [k for k in _models_with(name) if k != "support"]
-            if other and "unknown parameter" in str(exc):
-                raise ParameterError(f"{exc} (a parameter of model {', '.join(other)}: use "
-                                     f"--model {other[0]})") from None
-            raise
-        return base.replace(**values)
     values = _assignments(sets, m)
+    preset = preset or _default_preset(m, default_preset)
     base = m.preset(preset) if preset is not None else m.params()
     return base.replace(**values) if values else base
+
+
+def _default_preset(m, default_preset: str | None) -> str | None:
+    """The command's paper set where ``m`` is the paper's (built-in default) model."""
+    return default_preset if m.name == DEFAULT_MODEL and m.source == "built-in" else None
 
 
 def _without_eta(items) -> list:
@@ -98,11 +90,6 @@ def _without_eta(items) -> list:
             continue
         out.append(item)
     return out
-
-
-def _models_with(name: str) -> list:
-    from ..models.base import _other_models_with
-    return _other_models_with(name)
 
 
 def _assignments(items, m) -> dict:
@@ -123,11 +110,12 @@ def _assignments(items, m) -> dict:
 
 def preset_label(params, preset: str | None, default_preset: str | None = None) -> str:
     """What the outputs call the parameter set: the preset (``model/preset`` for a model other
-    than support), or ``model (defaults)``."""
-    name = params.model.name
-    if name == "support":
-        return preset or default_preset or "table1"
-    return f"{name}/{preset}" if preset else f"{name} (defaults)"
+    than the paper's), or ``model (defaults)``."""
+    m = params.model
+    preset = preset or _default_preset(m, default_preset)
+    if preset and m.name == DEFAULT_MODEL and m.source == "built-in":
+        return preset
+    return f"{m.name}/{preset}" if preset else f"{m.name} (defaults)"
 
 
 def resolve_method(params, method: str | None) -> str:

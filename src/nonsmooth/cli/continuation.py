@@ -11,7 +11,7 @@ import typer
 from ..errors import ParameterError
 from .analyses import V0Opt, X0Opt
 from .app import app
-from .common import (AtolOpt, ModelOpt, OutOpt, PlotOpt, PresetOpt, RtolOpt, SetOpt,
+from .common import (DEFAULT_MODEL, AtolOpt, ModelOpt, OutOpt, PlotOpt, PresetOpt, RtolOpt, SetOpt,
                      check_outputs, echo_written, load_params, preset_label, resolve_method,
                      save_outputs)
 from .stability import OrbitMethodOpt, _num, print_table
@@ -42,7 +42,7 @@ def continue_cmd(
     param: Annotated[str, typer.Option(
         "--param", show_default=False, help="the continued parameter, one of the model's "
                                             "(e.g. omega)")],
-    model: ModelOpt = "support",
+    model: ModelOpt = DEFAULT_MODEL,
     preset: PresetOpt = None,
     set_: SetOpt = None,
     k: Annotated[int, typer.Option("--k", help="period of the orbits in forcing periods")] = 1,
@@ -88,7 +88,6 @@ def continue_cmd(
     (fold, period doubling, Neimark-Sacker, grazing); the branch figure, stable solid,
     unstable dashed."""
     from ..analysis.continuation import continuation
-    from ..params import check_param_name
     from ..simulate import check_float, check_int
 
     params = load_params(preset, set_, model, "fig6a", method=method or "exact")
@@ -96,7 +95,7 @@ def continue_cmd(
         method = "exact"
     method = resolve_method(params, method)
     preset = preset_label(params, preset, "fig6a")
-    param = check_param_name(param, params)
+    param = params.model.param(param).name
     check_int("k", k, 1)
     check_int("transient", transient, 0)
     check_int("max_points", max_points, 2)
@@ -148,11 +147,10 @@ def _two_parameter(params, preset, param, param2, values, special, k, x0, v0, st
     import numpy as np
 
     from ..analysis.continuation import two_parameter_curve
-    from ..params import check_param_name
     from ..plot.continuation import plot_two_parameter
     from .analyses import value_range
 
-    check_param_name(param2, params)
+    params.model.param(param2)
     if values is None:
         raise ParameterError("values: --two-param needs --values FROM TO N")
     grid = value_range(values[0], values[1], values[2], f"{param2} values", field="values")

@@ -9,8 +9,8 @@ import typer
 from ..errors import ParameterError
 from .app import app
 from .analyses import HiddenIntOpt, _progress
-from .common import (AtolOpt, DaskOpt, ModelOpt, OutOpt, PlotOpt, PresetOpt, RtolOpt, SetOpt,
-                     TransitionOpt, WorkersOpt, check_outputs, chunk_store, echo_written, load_params,
+from .common import (DEFAULT_MODEL, AtolOpt, DaskOpt, ModelOpt, OutOpt, PlotOpt, PresetOpt, RtolOpt, SetOpt,
+                     WorkersOpt, check_outputs, chunk_store, echo_written, load_params,
                      preset_label, require_output, save_outputs)
 
 
@@ -40,7 +40,7 @@ def eta_study_cmd(
     eta: Annotated[Optional[list[str]], typer.Option(
         "--eta", "-e", help="band half-width(s) eta to audit, 0 < eta < 0.5: "
                             "--eta 0.28 0.028, --eta 0.28 --eta 0.028 or --eta 0.28,0.028")] = None,
-    model: ModelOpt = "support",
+    model: ModelOpt = DEFAULT_MODEL,
     preset: PresetOpt = None,
     set_: SetOpt = None,
     transient: Annotated[int, typer.Option(help="forcing periods discarded first")] = 300,
@@ -49,13 +49,14 @@ def eta_study_cmd(
     points: HiddenIntOpt("--points") = None,
     portrait_periods: HiddenIntOpt("--portrait-periods") = None,
     samples_per_period: Annotated[int, typer.Option(help="portrait samples per period")] = 200,
+    method: Annotated[str, typer.Option(
+        "--method", help="the smoothed method audited (support: smooth or smooth_eq12)")] = "smooth",
     x0: Annotated[float, typer.Option(help="initial X")] = 0.0,
     v0: Annotated[float, typer.Option(help="initial V")] = 0.0,
     rtol: RtolOpt = 1e-8,
     atol: AtolOpt = 1e-10,
     distance_tol: Annotated[float, typer.Option(
         help="section distance to the exact points counted as agreement (gap units)")] = 1e-3,
-    transition: TransitionOpt = "eq13",
     workers: WorkersOpt = None,
     dask: DaskOpt = None,
     out: OutOpt = None,
@@ -81,12 +82,12 @@ def eta_study_cmd(
         ds = eta_study(params, etas, transient=transient, record=record,
                        orbit_periods=orbit_periods, samples_per_period=samples_per_period,
                        x0=x0, v0=v0, rtol=rtol, atol=atol, distance_tol=distance_tol,
-                       transition=transition, workers=workers, progress=prog,
+                       method=method,
+                       workers=workers, progress=prog,
                        store=store, engine=engine)
     m = params.model
-    full = "Gamma+" if m.name == "support" else " or ".join(
-        nm for i, nm in enumerate(m.mode_names) if m.contact_modes >> i & 1) or "contact"
-    col = "Gamma+" if m.name == "support" else "contact"
+    full = m.contact_text
+    col = m.contact_label or "contact"
     from ..plot.eta_study import plot_eta_study
     save_outputs(ds, preset, out, plot, plot_eta_study, store=store)
     typer.echo(f"{preset}: exact model period {int(ds.exact_period) or 'none'}, "

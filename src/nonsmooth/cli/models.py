@@ -36,14 +36,11 @@ def model_lines(name: str) -> list[str]:
         modes = ", ".join(m.mode_names[i] for i in meth.modes) if meth.modes else "all"
         out.append(f"  {k:7s} {meth.description or '(no description)'} (modes: {modes})")
     out += ["", "presets (--preset NAME):"]
-    if m.name == "support":
-        out.append("  the paper's parameter sets: see `nonsmooth presets`")
-    else:
-        for k, (values, text) in m.presets.items():
-            vals = ", ".join(f"{a}={b:g}" for a, b in values.items())
-            out.append(f"  {k}: {text} ({vals})")
-        if not m.presets:
-            out.append("  none (the defaults above)")
+    for k, (values, text) in m.presets.items():
+        vals = ", ".join(f"{a}={b:g}" for a, b in values.items())
+        out.append(f"  {k}: {text} ({vals})")
+    if not m.presets:
+        out.append("  none (the defaults above)")
     out += ["", "references:"] + [f"  {r}" for r in m.references or ("none",)]
     return out
 

@@ -9,8 +9,8 @@ import typer
 
 from .analyses import SettleOpt, TransientOpt, X0Opt, V0Opt, _progress
 from .app import app
-from .common import (AtolOpt, DaskOpt, MethodOpt, ModelOpt, OutOpt, PlotOpt, PresetOpt,
-                     RtolOpt, SetOpt, TransitionOpt, WorkersOpt, check_outputs, chunk_store,
+from .common import (DEFAULT_MODEL, AtolOpt, DaskOpt, MethodOpt, ModelOpt, OutOpt, PlotOpt, PresetOpt,
+                     RtolOpt, SetOpt, WorkersOpt, check_outputs, chunk_store,
                      echo_written, load_params, preset_label, require_output, resolve_method,
                      save_outputs)
 
@@ -19,7 +19,7 @@ AxisOpt = tuple[str, float, float, int]
 
 @app.command("map")
 def map_cmd(
-    model: ModelOpt = "support",
+    model: ModelOpt = DEFAULT_MODEL,
     preset: PresetOpt = None,
     set_: SetOpt = None,
     x: Annotated[Optional[tuple[str, float, float, int]], typer.Option(
@@ -38,7 +38,6 @@ def map_cmd(
     method: MethodOpt = None,
     rtol: RtolOpt = 1e-8,
     atol: AtolOpt = 1e-10,
-    transition: TransitionOpt = "eq13",
     settle: SettleOpt = True,
     lyapunov: Annotated[Optional[bool], typer.Option(
         "--lyapunov/--no-lyapunov", show_default=False,
@@ -75,7 +74,7 @@ def map_cmd(
     with _progress(f"map {x[0]} x {y[0]}") as prog:
         ds = parameter_map(params, x=x, y=tuple(y), transient=transient, record=record,
                            method=method, start=start, x0=x0, v0=v0, rtol=rtol, atol=atol,
-                           transition=transition, settle=settle, lyapunov=lyapunov,
+                           settle=settle, lyapunov=lyapunov,
                            workers=workers, progress=prog, store=store, engine=engine,
                            chunk=chunk)
     from ..plot.parameter_map import plot_lambda1_map, plot_parameter_map

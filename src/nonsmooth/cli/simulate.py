@@ -7,14 +7,14 @@ from typing import Annotated, Optional
 import typer
 
 from .app import app
-from .common import (AtolOpt, MethodOpt, ModelOpt, OutOpt, PlotOpt, PresetOpt, RtolOpt, SetOpt,
-                     TransitionOpt, check_outputs, echo_written, load_params, preset_label,
+from .common import (DEFAULT_MODEL, AtolOpt, MethodOpt, ModelOpt, OutOpt, PlotOpt, PresetOpt, RtolOpt, SetOpt,
+                     check_outputs, echo_written, load_params, preset_label,
                      require_output, resolve_method, save_outputs)
 
 
 @app.command("simulate")
 def simulate_cmd(
-    model: ModelOpt = "support",
+    model: ModelOpt = DEFAULT_MODEL,
     preset: PresetOpt = None,
     set_: SetOpt = None,
     periods: Annotated[int, typer.Option(help="recorded forcing periods")] = 10,
@@ -27,7 +27,6 @@ def simulate_cmd(
     method: MethodOpt = None,
     rtol: RtolOpt = 1e-8,
     atol: AtolOpt = 1e-10,
-    transition: TransitionOpt = "eq13",
     out: OutOpt = None,
     plot: PlotOpt = None,
 ):
@@ -44,11 +43,11 @@ def simulate_cmd(
     spp = {} if samples_per_period is None else {"samples_per_period": samples_per_period}
     with _progress("simulate") as prog:
         ds = simulate(params, periods=periods, transient=transient, x0=x0, v0=v0, method=method,
-                      rtol=rtol, atol=atol, transition=transition, progress=prog, **spp)
+                      rtol=rtol, atol=atol, progress=prog, **spp)
     from ..plot.time_response import plot_time_response
     save_outputs(ds, preset, out, plot, plot_time_response)
     typer.echo(f"{preset}: {periods} periods after {transient}, max X = {float(ds.max_X):.6g}, "
-               f"min X = {float(ds.min_X):.6g}, {'regions' if params.model.name == 'support' else 'modes'} visited: "
+               f"min X = {float(ds.min_X):.6g}, {params.model.mode_word} visited: "
                f"{', '.join(mask_names(ds.regions_visited))}")
     echo_written(out, plot)
 
@@ -56,7 +55,7 @@ def simulate_cmd(
 @app.command("presets")
 def presets_cmd():
     """List the built-in parameter sets and where they come from in the paper."""
-    from ..presets import PRESETS, preset as get
+    from ..models.support import PRESETS, preset as get
     for name, (_, source) in PRESETS.items():
         p = get(name)
         vals = ", ".join(f"{k}={v:g}" for k, v in p.as_dict().items())

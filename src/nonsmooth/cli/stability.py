@@ -10,7 +10,7 @@ import typer
 
 from .analyses import TransientOpt, V0Opt, X0Opt, _progress
 from .app import app
-from .common import (AtolOpt, MethodOpt, ModelOpt, OutOpt, PlotOpt, PresetOpt, RtolOpt, SetOpt,
+from .common import (DEFAULT_MODEL, AtolOpt, MethodOpt, ModelOpt, OutOpt, PlotOpt, PresetOpt, RtolOpt, SetOpt,
                      check_outputs, echo_written, load_params, preset_label, resolve_method,
                      save_outputs)
 
@@ -54,7 +54,7 @@ def _verdict_reason(cls: int) -> str:
 
 @app.command("lyapunov")
 def lyapunov_cmd(
-    model: ModelOpt = "support",
+    model: ModelOpt = DEFAULT_MODEL,
     preset: PresetOpt = None,
     set_: SetOpt = None,
     periods: Annotated[int, typer.Option(
@@ -103,7 +103,7 @@ def lyapunov_cmd(
 
 @app.command("orbit")
 def orbit_cmd(
-    model: ModelOpt = "support",
+    model: ModelOpt = DEFAULT_MODEL,
     preset: PresetOpt = None,
     set_: SetOpt = None,
     k: Annotated[int, typer.Option("--k", help="period of the orbit in forcing periods")] = 1,

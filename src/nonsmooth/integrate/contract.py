@@ -25,7 +25,7 @@ never print or raise: they return a status code from :mod:`nonsmooth.status`.
 OPT_RTOL = 0
 OPT_ATOL = 1
 OPT_MAX_STEPS = 2  # steps allowed per forcing period, on average over a call
-OPT_TRANSITION = 3  # models.support.switch.TRANSITION_EQ13 / TRANSITION_EQ12 (support, smooth only)
+OPT_VARIANT = 3  # Method.variant: a specialised kernel's variant (support smooth: 0 eq. 13, 1 eq. 12)
 OPT_OMEGA = 4  # index of the forcing frequency omega in p (generic kernel)
 OPT_N = 5  # state dimension n >= 2 (generic kernel)
 OPT_NMEM = 6  # number of discrete memory slots (generic kernel)

@@ -86,6 +86,14 @@ def _load_user(path: str, attr: str) -> Model:
     return obj
 
 
+def __getattr__(name: str):
+    """The built-in models' modules as attributes (``nonsmooth.models.support``), loaded on
+    first use."""
+    if name in BUILTIN:
+        return importlib.import_module(BUILTIN[name])
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
 class _CallablePackage(types.ModuleType):
     """``nonsmooth.models`` is this package and, called, lists the built-in models."""
 

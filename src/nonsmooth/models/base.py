@@ -43,9 +43,14 @@ signatures of :mod:`nonsmooth.integrate.contract`). It declares
 
 * what analyses and plots need: ``contact(params, mask, max_X, min_X)`` (does an orbit with
   this visited-mode mask and these extremes of X count as "in contact", named
-  ``contact_name``; default: a mode of the bit mask ``contact_modes`` visited),
+  ``contact_name``; default: a mode of the bit mask ``contact_modes`` visited; ``contact_label``
+  a short name of those modes in tables, e.g. ``Gamma+``),
   ``contact_level(params)`` (the X at which contact starts, for the contact onset omega_a of
-  ``resonance_curve``; None where it has no meaning), ``lines(params, method)`` (values of X to draw, with labels) and, per
+  ``resonance_curve``; None where it has no meaning), ``lines(params, method)`` (values of X to draw, with labels;
+  ``params`` may be None when a result's parameters cannot be read), display data for figures
+  and the CLI (``mode_labels``: mathtext legend labels per mode, default ``mode_names``;
+  ``line_labels``: mathtext for the labels of ``lines``; ``mode_word``: what the modes are
+  called, e.g. "regions") and, per
   method, ``flow_is_homeomorphism`` (false where trajectories merge, e.g. in sticking: basins
   then never use the certified early labelling, which assumes an injective map).
 
@@ -66,6 +71,7 @@ from typing import Callable
 
 import numpy as np
 
+from .._builtin import BUILTIN, DEFAULT_MODEL  # noqa: F401 - the registry's names
 from ..errors import ParameterError
 
 #: Kernel codes of :func:`nonsmooth.kernels.run`: the generic kernel, and the specialised
@@ -126,8 +132,8 @@ def param_index(params) -> dict:
 
 
 class ParamsBase:
-    """Marker base of every model's validated parameters (``Params`` of the support model,
-    :class:`ModelParams` of the others); ``params.model`` is their model."""
+    """Marker base of a model's validated parameters (:class:`ModelParams`); ``params.model``
+    is their model."""
 
     __slots__ = ()
 
@@ -201,7 +207,8 @@ class Method:
     form. ``modes``: the mode codes this method uses. ``rtol``/``atol``: tolerances it
     enforces at most (the exact method of a model with nonlinear modes integrates those at a
     tight tolerance). ``kernel``: a specialised kernel code of a built-in model, else the
-    generic kernel. ``continuous_memory``: the memory slots that are continuous functions of
+    generic kernel; ``variant``: which variant of its method that kernel runs (``opts`` slot
+    ``OPT_VARIANT``; the generic kernel ignores it). ``continuous_memory``: the memory slots that are continuous functions of
     the state (e.g. an entry velocity), as opposed to discrete flags; tangent dynamics carry
     them, and ``jacobian`` must give the field's derivative with respect to slot i in column
     n + i of J (J has n + n_memory columns, the memory ones zeroed before each call)."""
@@ -220,6 +227,7 @@ class Method:
     atol: float | None = None
     kernel: int = KERNEL_GENERIC
     continuous_memory: tuple = ()
+    variant: int = 0
 
 
 def _no_linear(mode, p, out):
@@ -249,6 +257,10 @@ class Model:
     contact_name: str = "contact"
     contact_level: Callable | None = None
     lines: Callable | None = None
+    mode_labels: tuple = ()
+    line_labels: dict = _field(default_factory=dict)
+    mode_word: str = "modes"
+    contact_label: str = ""
     source: str = "built-in"
 
     def __post_init__(self):
@@ -382,6 +394,13 @@ class Model:
         """[(X value, label), ...] to draw on time responses and sections."""
         return list(self.lines(params, method)) if self.lines is not None else []
 
+    @property
+    def contact_text(self) -> str:
+        """The full-contact modes as the CLI's tables name them (``contact_label``, else the
+        names of the ``contact_modes``, else "contact")."""
+        return self.contact_label or " or ".join(
+            nm for i, nm in enumerate(self.mode_names) if self.contact_modes >> i & 1) or "contact"
+
     def summary(self) -> dict:
         return {"name": self.name, "description": self.description,
                 "parameters": {p.name: dict(default=p.default, range=p.range_text,
@@ -485,13 +504,6 @@ def _sample_check(model, method, m, fns, max_guards):
 
 
 # ---- registry --------------------------------------------------------------------------------
-#: Built-in models: name -> module defining ``MODEL``.
-BUILTIN = {
-    "support": "nonsmooth.models.support",
-    "two_sided": "nonsmooth.models.two_sided",
-    "impact": "nonsmooth.models.impact",
-    "stick_slip": "nonsmooth.models.stick_slip",
-}
 
 #: Parameter names of the built-in models (for "a parameter of another model" messages),
 #: filled as models load.

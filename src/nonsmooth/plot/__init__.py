@@ -15,12 +15,10 @@ import importlib
 MODE_COLORS = ("#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564b", "#e377c2",
                "#17becf")
 REGION_COLORS = MODE_COLORS[:4]
-#: Legend labels of the support model's regions (mathtext); other models use their mode names.
+#: Legend labels of the paper's regions (mathtext): the support model's ``mode_labels``; every
+#: model's own labels are ``Model.mode_labels`` (default ``mode_names``) and
+#: ``Model.line_labels``.
 REGION_LABELS = (r"$\Gamma_-$", r"$\Sigma_\alpha$", r"$\Sigma_\beta$", r"$\Gamma_+$")
-#: Mathtext legend labels of a model's mode codes, by model name (default: ``mode_names``).
-MODE_LABELS = {"support": REGION_LABELS}
-#: Mathtext for the labels of a model's lines (``Model.plot_lines``), by model name.
-LINE_LABELS = {"support": {"support (X = 1)": r"support $X = 1$"}}
 
 #: Plot function -> module of this package that defines it.
 _PLOTS = {
@@ -42,7 +40,7 @@ _PLOTS = {
     "plot_lambda1_map": ".parameter_map",
 }
 
-__all__ = ["MODE_COLORS", "MODE_LABELS", "LINE_LABELS", "REGION_COLORS", "REGION_LABELS",
+__all__ = ["MODE_COLORS", "REGION_COLORS", "REGION_LABELS",
            *_PLOTS]
 
 

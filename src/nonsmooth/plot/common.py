@@ -11,7 +11,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from . import LINE_LABELS, MODE_COLORS, MODE_LABELS
+from .._builtin import DEFAULT_MODEL
+from . import MODE_COLORS
 
 #: Label prefix of the secondary lines of ``Model.plot_lines`` (band edges of the smooth
 #: method), drawn thinner and grey, with one legend entry.
@@ -29,9 +30,10 @@ def new_figure(nrows: int = 1, ncols: int = 1, *, figsize=None, **subplots_kw):
 
 # ---- the model of a dataset ------------------------------------------------------------------
 def model_name(ds) -> str:
-    """The model name of a result (``model`` attribute; ``"support"`` when missing)."""
+    """The model name of a result (``model`` attribute; the paper's model, the default, when
+    missing: files written before the model interface)."""
     attrs = getattr(ds, "attrs", ds)
-    return str(attrs.get("model", "support"))
+    return str(attrs.get("model", DEFAULT_MODEL))
 
 
 def model_of(ds):
@@ -54,11 +56,11 @@ def mode_colors(m, n=None) -> tuple:
 
 
 def mode_labels(m, n=None) -> tuple:
-    """Legend label per mode code of model ``m``: ``MODE_LABELS[name]`` (mathtext; the support
-    model's Gamma-/Sigma labels), else the model's ``mode_names``."""
+    """Legend label per mode code of model ``m``: its ``mode_labels`` (mathtext, e.g. the
+    support model's Gamma-/Sigma labels), else its ``mode_names``."""
     if m is None:
         return tuple(f"mode {i}" for i in range(n or len(MODE_COLORS)))
-    return tuple(MODE_LABELS.get(m.name, m.mode_names))
+    return tuple(m.mode_labels or m.mode_names)
 
 
 def param_symbol(m, name: str) -> str:
@@ -88,20 +90,16 @@ def model_lines(ds, method=None, *, band_edges: bool = True, **point) -> list:
     """``[(X value, label), ...]`` of the dataset's model (``Model.plot_lines``) at its
     parameters (``point``: values of swept parameters) for ``method`` (default: the dataset's
     ``method`` attribute). ``band_edges=False`` leaves out the band-edge lines. Labels are
-    the model's (mathtext where ``LINE_LABELS`` has one)."""
+    the model's (mathtext where its ``line_labels`` has one)."""
     m = model_of(ds)
     if m is None:
         return []
     method = method or str(getattr(ds, "attrs", {}).get("method", "smooth"))
-    p = params_of(ds, **point)
-    if p is None:
-        lines = [(1.0, "support (X = 1)")] if m.name == "support" else []
-    else:
-        try:
-            lines = m.plot_lines(p, method)
-        except Exception:  # noqa: BLE001 - a model's lines must not break a figure
-            lines = []
-    tex = LINE_LABELS.get(m.name, {})
+    try:  # parameters None: the lines that do not depend on them
+        lines = m.plot_lines(params_of(ds, **point), method)
+    except Exception:  # noqa: BLE001 - a model's lines must not break a figure
+        lines = []
+    tex = m.line_labels
     return [(float(x), tex.get(lab, lab)) for x, lab in lines
             if band_edges or not str(lab).startswith(BAND_EDGE)]
 
@@ -126,7 +124,7 @@ def draw_model_lines(ax, ds, orient: str = "v", *, label: bool = True, band_edge
     return lines
 
 
-def scatter_by_region(ax, x, y, region, s=2.0, legend=True, model="support", **kw):
+def scatter_by_region(ax, x, y, region, s=2.0, legend=True, model=DEFAULT_MODEL, **kw):
     """Scatter (x, y) coloured by mode (region) code; only the modes present get a legend
     entry. ``model``: a Model, a model name or a dataset naming one (colours and labels per
     mode code; default the support model's four regions); None: generic ``mode k`` labels."""
@@ -164,7 +162,7 @@ def draw_band_edges(ax, eta, omega_s, xi_s, vlim=None, label=True):
 def has_support_bands(ds, method=None) -> bool:
     """True for the support model's smooth method (the bands h_alpha, h_beta = +-eta)."""
     method = method or getattr(ds, "attrs", {}).get("method", "smooth")
-    return model_name(ds) == "support" and method == "smooth"
+    return model_name(ds) == DEFAULT_MODEL and method != "exact"
 
 
 def draw_phase_lines(ax, ds, *, label: bool = True, eta=None, vlim=None, **point) -> None:

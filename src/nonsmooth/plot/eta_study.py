@@ -6,16 +6,15 @@ import math
 
 import numpy as np
 
-from .common import (draw_phase_lines, model_lines, model_of, new_figure, param_title,
+from .common import (draw_phase_lines, mode_labels, model_lines, model_of, new_figure, param_title,
                      scatter_by_region)
 
 
 def _full_contact(ds) -> str:
     """How the verdict names the model's full-contact modes (support: Gamma+)."""
     m = model_of(ds)
-    if m is None or m.name == "support":
-        return "$\\Gamma_+$"
-    names = [n for k, n in enumerate(m.mode_names) if (m.contact_modes >> k) & 1]
+    labels = mode_labels(m)
+    names = [labels[k] for k in range(len(labels)) if m is not None and (m.contact_modes >> k) & 1]
     return " / ".join(names) or "contact"
 
 

@@ -30,7 +30,7 @@ def gaps(evidence: dict, quick_ids: list[str]) -> list[tuple[str, str, list[str]
          "memory); eq. 13a interpolates the spring force in X and ramps the support damping from "
          "the entry velocity X'_a (a discrete memory), eq. 13b interpolates the support force "
          "linearly in h_beta. They agree on the q = 1 edges but not on the Sigma_alpha/Sigma_beta "
-         "border. We use eq. 13 (what the paper integrated) by default; `transition=\"eq12\"` "
+         "border. We use eq. 13 (what the paper integrated) by default; `method=\"smooth_eq12\"` "
          "selects eq. 12.", ev("eq12")),
         ("The eta values used differ from the stated reference",
          "The text fixes eta_hat = eta g = 1e-5 'for all simulations', yet uses eta = 2.5e-6 "

@@ -142,7 +142,7 @@ _BYTES_PER_POINT = 112
 
 def basins(params: ParamsBase, *, x=(-3.0, 3.0), v=(-3.0, 3.0), grid=400, method: str = "smooth",
            transient: int = 10, max_periods: int = 1000, max_period: int = 16, rtol: float = 1e-8,
-           atol: float = 1e-10, transition: str = "eq13", early_stop: bool = True,
+           atol: float = 1e-10, early_stop: bool = True,
            samples_per_period: int = 200, workers: int | None = None,
            progress=None, lyapunov: bool | None = None, store=None,
            engine=None) -> xr.Dataset:
@@ -193,7 +193,7 @@ def basins(params: ParamsBase, *, x=(-3.0, 3.0), v=(-3.0, 3.0), grid=400, method
     max_periods = check_int("max_periods", max_periods, 1)
     max_period = check_int("max_period", max_period, 1)
     spp = check_int("samples_per_period", samples_per_period, 2)
-    solver = Solver(method=method, rtol=rtol, atol=atol, transition=transition,
+    solver = Solver(method=method, rtol=rtol, atol=atol,
                     model=params.model)
     nw = resolve_workers(workers)
     n = nx * nv

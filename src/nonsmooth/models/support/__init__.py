@@ -2,38 +2,29 @@
 support across a gap (eqs. 4-14).
 
 Free flight  X'' + xi X' + omega0^2 X = F0 cos(omega t); in contact the support adds
-omega_s^2 (X - 1) + xi_s X'. ``method="smooth"`` is the paper's switch model with bands of
-half-width eta (regions Gamma-, Sigma_alpha, Sigma_beta, Gamma+ of eq. 14; transition fields
-eq. 13, or eq. 12 with ``transition="eq12"``); ``method="exact"`` is the non-smooth system
-(eta = 0), event-driven in closed form. Both run on specialised kernels with these functions
-inlined (``smooth_kernel``, ``exact_kernel``); the generic descriptions in :mod:`.generic`
-describe the same model through the interface of :mod:`nonsmooth.models.base` (used by the
-generic kernel, and tested against the specialised kernels).
+omega_s^2 (X - 1) + xi_s X'. Methods:
+
+* ``smooth``: the paper's switch model with bands of half-width eta (regions Gamma-,
+  Sigma_alpha, Sigma_beta, Gamma+ of eq. 14; transition fields eq. 13);
+* ``smooth_eq12``: the same regions with the convex transition fields of eq. 12;
+* ``exact``: the non-smooth system (eta = 0), event-driven in closed form.
+
+All three run on specialised kernels with these functions inlined (``smooth_kernel``,
+``exact_kernel``); the generic descriptions in :mod:`.generic` describe the same model through
+the interface of :mod:`nonsmooth.models.base` (used by the generic kernel for tangent
+dynamics, and tested against the specialised kernels). Its parameters and the paper's sets
+are in :mod:`.parameters`.
 """
 
 from __future__ import annotations
 
-from ...errors import ParameterError
-from ...presets import PRESETS
-from ..base import KERNEL_SUPPORT_EXACT, KERNEL_SUPPORT_SMOOTH, Method, Model, Param, _PARAM_NAMES
-from . import generic as g
-from .switch import REGION_NAMES
+import warnings
 
-PARAMETERS = (
-    Param("omega0", 1.0, low=0.0, low_open=True, units="rad/s",
-          long_name="natural frequency sqrt(k/m)", symbol=r"$\omega_0$"),
-    Param("omega_s", 17.32, low=0.0, units="rad/s",
-          long_name="support frequency sqrt(k_s/m)", symbol=r"$\omega_s$"),
-    Param("xi", 0.05, low=0.0, units="1/s",
-          long_name="damping c/m (multiplies X' directly)", symbol=r"$\xi$"),
-    Param("xi_s", 0.6, low=0.0, units="1/s", long_name="support damping c_s/m",
-          symbol=r"$\xi_s$"),
-    Param("F0", 0.3125, units="1/s^2", long_name="forcing amplitude f0/(m g)", symbol=r"$F_0$"),
-    Param("omega", 0.91, low=0.0, low_open=True, units="rad/s", long_name="forcing frequency",
-          symbol=r"$\omega$"),
-    Param("eta", 1e-5, low=0.0, high=0.5, low_open=True, high_open=True, units="1",
-          long_name="half-width of the switching bands (eta_hat / g)", symbol=r"$\eta$"),
-)
+from ..base import (KERNEL_SUPPORT_EXACT, KERNEL_SUPPORT_SMOOTH, Method, Model, ModelParams,
+                    _PARAM_NAMES)
+from . import generic as g
+from .parameters import PARAM_NAMES, PARAMETERS, PRESETS, check, dimensionless
+from .switch import REGION_NAMES, TRANSITION_EQ12
 
 
 def _contact(params, mask, max_X, min_X):
@@ -43,24 +34,12 @@ def _contact(params, mask, max_X, min_X):
 
 def _lines(params, method):
     lines = [(1.0, "support (X = 1)")]
-    if method == "smooth":
+    if method != "exact" and params is not None:
         lines += [(1.0 - params.eta, "band edge"), (1.0 + params.eta, "band edge")]
     return lines
 
 
-class _SupportModel(Model):
-    """The support model: its parameters are the package's :class:`~nonsmooth.Params` (the
-    same names, ranges and one-line messages as before the model interface)."""
-
-    def params(self, **values):
-        from ...params import Params
-        for k in values:
-            if k not in self.param_names:
-                raise ParameterError(self.unknown_message(k))
-        return Params(**{p.name: values.get(p.name, p.default) for p in self.parameters})
-
-
-MODEL = _SupportModel(
+MODEL = Model(
     name="support",
     description="forced oscillator hitting a spring-damper support across a gap (the paper's "
                 "switch model, eqs. 4-14)",
@@ -75,6 +54,12 @@ MODEL = _SupportModel(
                          flow_is_homeomorphism=True, kernel=KERNEL_SUPPORT_SMOOTH,
                          continuous_memory=(0,),
                          description="switch model, eqs. 10-14 (RKF45, located switches)"),
+        "smooth_eq12": Method(g.smooth_eq12_field, g.smooth_eq12_jacobian, g.smooth_guards,
+                              g.smooth_transition, g.smooth_initial, modes=(0, 1, 2, 3),
+                              flow_is_homeomorphism=True, kernel=KERNEL_SUPPORT_SMOOTH,
+                              variant=TRANSITION_EQ12,
+                              description="switch model with the convex transition fields of "
+                                          "eq. 12 instead of eq. 13 (RKF45, located switches)"),
         "exact": Method(g.exact_field, g.exact_jacobian, g.exact_guards, g.exact_transition,
                         g.exact_initial, g.exact_linear, closed_form=True, modes=(0, 3),
                         flow_is_homeomorphism=True, kernel=KERNEL_SUPPORT_EXACT,
@@ -87,6 +72,52 @@ MODEL = _SupportModel(
     contact_name="contact with the support (max X >= 1 and a band or Gamma+ visited)",
     lines=_lines,
     contact_level=lambda params: 1.0,
+    mode_labels=(r"$\Gamma_-$", r"$\Sigma_\alpha$", r"$\Sigma_\beta$", r"$\Gamma_+$"),
+    line_labels={"support (X = 1)": r"support $X = 1$"},
+    mode_word="regions",
+    contact_label="Gamma+",
     presets=PRESETS,
+    check=check,
 )
 _PARAM_NAMES["support"] = MODEL.param_names
+
+
+def preset(name: str) -> ModelParams:
+    """The paper's parameter set ``name`` (see :data:`PRESETS` or ``nonsmooth presets``)."""
+    return MODEL.preset(name)
+
+
+def from_dimensional(**quantities) -> ModelParams:
+    """The support model's parameters from dimensional quantities (eq. 3): ``m, k, c, k_s,
+    c_s, f0, g, omega`` and ``eta_hat`` (see :func:`.parameters.dimensionless`)."""
+    return MODEL.params(**dimensionless(**quantities))
+
+
+def _deprecated(old: str, new: str) -> None:
+    warnings.warn(f"nonsmooth.{old} is deprecated: use {new}", DeprecationWarning, stacklevel=3)
+
+
+class _ParamsAlias(type):
+    def __call__(cls, *args, **values):
+        _deprecated("Params(...)", "nonsmooth.model('support').params(...)")
+        if len(args) > len(PARAM_NAMES):
+            raise TypeError(f"Params takes at most {len(PARAM_NAMES)} values, got {len(args)}")
+        return MODEL.params(**dict(zip(PARAM_NAMES, args)), **values)
+
+    def __instancecheck__(cls, obj):
+        return isinstance(obj, ModelParams) and obj.model is MODEL
+
+
+class Params(metaclass=_ParamsAlias):
+    """Deprecated alias (one release) of ``nonsmooth.model("support").params``: the support
+    model's values are ordinary :class:`~nonsmooth.models.base.ModelParams`."""
+
+    @staticmethod
+    def from_dimensional(**quantities) -> ModelParams:
+        _deprecated("Params.from_dimensional", "nonsmooth.models.support.from_dimensional")
+        return from_dimensional(**quantities)
+
+    @staticmethod
+    def from_attrs(source, **point) -> ModelParams:
+        _deprecated("Params.from_attrs", "nonsmooth.model('support').params_from_attrs")
+        return MODEL.params_from_attrs(source, _call="Params.from_attrs", **point)

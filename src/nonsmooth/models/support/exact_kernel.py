@@ -64,7 +64,7 @@ Corner cases (all end with a status, never a hang)
 * ``status.EVENT_FAILED``: a certified root that the refinement could not converge (not
   observed).
 
-``opts[OPT_RTOL]``, ``opts[OPT_ATOL]`` and ``opts[OPT_TRANSITION]`` are ignored: the solution
+``opts[OPT_RTOL]``, ``opts[OPT_ATOL]`` and ``opts[OPT_VARIANT]`` are ignored: the solution
 is exact to round-off and event times are located to ``tol_t`` = 2e-14 max(1, T).
 ``state[ST_VA]`` and ``state[ST_H]`` are not used (set to V and 0 on return).
 The local time restarts at 0 at each forcing period; the piece length is reset there, so the

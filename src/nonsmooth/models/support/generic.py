@@ -14,7 +14,7 @@ import math
 
 import numba as nb
 
-from ...params import IDX
+from .parameters import IDX
 from .switch import (GAMMA_MINUS, GAMMA_PLUS, SIGMA_ALPHA, SIGMA_BETA, beta_ratio,
                      crossed_normal, region)
 from ..oscillator import row as _row
@@ -26,7 +26,7 @@ _FREE = 0
 _CONTACT = 3
 
 
-# ---- smooth (switch model, eq. 13) ----------------------------------------------------------
+# ---- smooth (switch model, eq. 13; eq. 12 below shares its regions) ----------------------------------------------------------
 def smooth_field(mode, t, c, s, u, p, mem, du):
     w02 = p[_W0] * p[_W0]
     ws2 = p[_WS] * p[_WS]
@@ -57,6 +57,51 @@ def smooth_jacobian(mode, t, c, s, u, p, mem, J):
         J[1, 2] = xis * (1.0 - (u[0] - 1.0 + eta) / (2.0 * eta))  # d/d mem[0] (Va, eq. 13a)
     elif mode == SIGMA_BETA:
         ax, av = ax - 0.5 * ws2, av - 0.5 * xis
+    J[0, 0] = 0.0
+    J[0, 1] = 1.0
+    J[1, 0] = ax
+    J[1, 1] = av
+    return 0
+
+
+def smooth_eq12_field(mode, t, c, s, u, p, mem, du):
+    # the convex combinations of eq. 12: (1 - q) f_- + q f_+ in Sigma_alpha (12a), (1 - q) f_+
+    # + q f_- in Sigma_beta (12b); no memory
+    w02 = p[_W0] * p[_W0]
+    ws2 = p[_WS] * p[_WS]
+    xi, xis, eta = p[_XI], p[_XIS], p[_ETA]
+    X, V = u[0], u[1]
+    a = -w02 * X - xi * V + p[_F0] * c
+    support = -ws2 * (X - 1.0) - xis * V  # f_+ - f_- (second component)
+    if mode == GAMMA_PLUS:
+        a += support
+    elif mode == SIGMA_ALPHA:
+        a += (X - 1.0 + eta) / (2.0 * eta) * support
+    elif mode == SIGMA_BETA:
+        r = beta_ratio(p[_WS], p[_XIS])
+        a += (1.0 - (-(X - 1.0) + eta - r * V) / (2.0 * eta)) * support
+    du[0] = V
+    du[1] = a
+    return 0
+
+
+def smooth_eq12_jacobian(mode, t, c, s, u, p, mem, J):
+    w02 = p[_W0] * p[_W0]
+    ws2 = p[_WS] * p[_WS]
+    xi, xis, eta = p[_XI], p[_XIS], p[_ETA]
+    X, V = u[0], u[1]
+    support = -ws2 * (X - 1.0) - xis * V
+    ax, av = -w02, -xi
+    if mode == GAMMA_PLUS:
+        ax, av = ax - ws2, av - xis
+    elif mode == SIGMA_ALPHA:
+        q = (X - 1.0 + eta) / (2.0 * eta)
+        ax, av = ax + support / (2.0 * eta) - q * ws2, av - q * xis
+    elif mode == SIGMA_BETA:
+        r = beta_ratio(p[_WS], p[_XIS])
+        w = 1.0 - (-(X - 1.0) + eta - r * V) / (2.0 * eta)
+        ax = ax + support / (2.0 * eta) - w * ws2
+        av = av + support * r / (2.0 * eta) - w * xis
     J[0, 0] = 0.0
     J[0, 1] = 1.0
     J[1, 0] = ax

@@ -39,7 +39,7 @@ from ...integrate.contract import (
     OPT_ATOL,
     OPT_MAX_STEPS,
     OPT_RTOL,
-    OPT_TRANSITION,
+    OPT_VARIANT,
     ST_H,
     ST_MODE,
     ST_V,
@@ -238,7 +238,7 @@ def advance_smooth(p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_ou
     r = beta_ratio(ws, xis)
     rtol = opts[OPT_RTOL]
     atol = opts[OPT_ATOL]
-    tr = int(opts[OPT_TRANSITION])
+    tr = int(opts[OPT_VARIANT])
 
     X = state[ST_X]
     V = state[ST_V]

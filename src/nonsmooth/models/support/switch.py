@@ -17,7 +17,8 @@ code  region   definition
 The four sets partition the plane. Note h_alpha + h_beta = -(xi_s/omega_s^2) V, so the border
 between Sigma_a and Sigma_b is the line V = 0 inside the band.
 
-Transition fields. Two variants are implemented:
+Transition fields. Two variants are implemented (the methods ``smooth`` and ``smooth_eq12``
+of the model; the specialised kernel reads which from ``opts[OPT_VARIANT]``):
 
 * ``TRANSITION_EQ13`` (default, the paper's eqs. 13a/13b). In Sigma_b the support force is
   interpolated *linearly in h_beta* between its values at the two band edges. In Sigma_a the
@@ -52,7 +53,6 @@ REGION_NAMES = ("Gamma_minus", "Sigma_alpha", "Sigma_beta", "Gamma_plus")
 
 TRANSITION_EQ13 = 0
 TRANSITION_EQ12 = 1
-TRANSITIONS = {"eq13": TRANSITION_EQ13, "eq12": TRANSITION_EQ12}
 
 
 @nb.njit(cache=True, inline="always")

@@ -25,8 +25,8 @@ def method_text(ds) -> str:
     a = ds.attrs
     m = str(a.get("method", "smooth"))
     parts = [m]
-    if m == "smooth":
-        parts.append(f"switch model ({a.get('transition', 'eq13')}), RKF45")
+    if m in ("smooth", "smooth_eq12"):
+        parts.append(f"switch model ({'eq12' if m == 'smooth_eq12' else 'eq13'}), RKF45")
     else:
         parts.append("exact non-smooth, closed form between events")
     if "rtol" in a:
@@ -44,14 +44,14 @@ def point_summary(ds) -> str:
             f"contact = {int(value(ds, 'contact', 0))}")
 
 
-def run_poincare(ctx, params, *, x0=IC[0], v0=IC[1], method="smooth", transition="eq13",
-                 record=None, transient=None):
+def run_poincare(ctx, params, *, x0=IC[0], v0=IC[1], method="smooth", record=None,
+                 transient=None):
     from ...analysis.poincare import poincare
     return poincare(params, record=record or ctx.setting("fig10, fig12", "record"),
                     transient=transient or ctx.setting("fig10, fig12", "transient"), x0=x0, v0=v0,
-                    method=method, transition=transition, orbit_samples=1000,
-                    # the tangent dynamics (lambda1) follow eq. 13 only
-                    lyapunov=method == "exact" or transition == "eq13")
+                    method=method, orbit_samples=1000,
+                    # lambda1 where the figures report it (not for the eq. 12 variant runs)
+                    lyapunov=method != "smooth_eq12")
 
 
 def try_exact(ctx, params, **kw):

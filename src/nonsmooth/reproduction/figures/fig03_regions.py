@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ...presets import preset
+from ...models.support import preset
 from ..access import x_extrema
 from ..core import DIFFERS, NOT_STATED, agree_if, figure, fmt
 from ._common import IC, REGIONS, gap, method_text, region_names
@@ -48,7 +48,7 @@ def fig3(ctx, rec):
     mx = fmt(x_extrema(ds)[0], 7)
     try:
         d12 = simulate(p, periods=periods, transient=transient, samples_per_period=200,
-                       x0=IC[0], v0=IC[1], transition="eq12")
+                       x0=IC[0], v0=IC[1], method="smooth_eq12")
         gap(ctx, "eq12", f"Fig. 3 (Table 1): max X over the settled orbit {mx} with eq. 13 and "
                          f"{fmt(x_extrema(d12)[0], 7)} with eq. 12")
     except Exception as exc:  # noqa: BLE001

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ...presets import preset
+from ...models.support import preset
 from ..access import number, value, x_extrema
 from ..core import DIFFERS, NOT_STATED, agree_if, figure, fmt, lyapunov_text, period_text
 from ._common import IC, attractor_note, gap, ic_grid, method_text, note_safely, region_names
@@ -162,7 +162,7 @@ def fig4_evidence(ctx, ds, i, p, kw) -> str:
              f"{period_text(value(ds, 'exact_period', 0))}"]
     try:
         from ...analysis.eta_study import eta_study
-        d12 = eta_study(p, [eta], **{**kw, "transition": "eq12"})
+        d12 = eta_study(p, [eta], **{**kw, "method": "smooth_eq12"})
         parts.append(f"with the eq. 12 transitions: reaches_gamma_plus = "
                      f"{int(d12['reaches_gamma_plus'].values[0])}")
     except Exception as exc:  # noqa: BLE001

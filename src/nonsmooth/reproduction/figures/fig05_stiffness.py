@@ -4,8 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ...params import PARAM_INFO
-from ...presets import preset
+from ...models.support import MODEL, preset
 from ..access import value, x_extrema
 from ..core import DIFFERS, NOT_STATED, agree_if, figure, fmt, period_text
 from ._common import IC, attractor_note, ic_grid, method_text, note_safely, run_poincare
@@ -70,8 +69,8 @@ def fig5(ctx, rec):
         raise RuntimeError("every support stiffness failed")
     ds = xr.concat(runs, dim="omega_s", combine_attrs="drop_conflicts")
     ds.attrs["preset"] = "table2"
-    desc, unit, _ = PARAM_INFO["omega_s"]
-    ds["omega_s"].attrs.update(long_name=desc, units=unit)
+    ws = MODEL.param("omega_s")
+    ds["omega_s"].attrs.update(long_name=ws.long_name, units=ws.units)
     rec.method = method_text(ds)
     ctx.save(ds, "fig5")
     ctx.savefig(plot_support_stiffness(ds), "fig5")

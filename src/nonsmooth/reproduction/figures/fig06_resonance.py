@@ -6,7 +6,7 @@ import math
 
 import numpy as np
 
-from ...presets import preset
+from ...models.support import preset
 from ..access import number
 from ..core import DIFFERS, NOT_STATED, agree_if, figure, fmt
 from ._common import IC, method_text

@@ -6,7 +6,7 @@ import math
 
 import numpy as np
 
-from ...presets import preset
+from ...models.support import preset
 from ..core import DIFFERS, NOT_STATED, agree_if, figure, fmt, period_text
 from ._common import BASIN_WINDOW, find_orbit, gap, method_text, note_safely, orbit_text
 from .fig06_resonance import jump_width, resonance

@@ -6,7 +6,7 @@ import math
 
 import numpy as np
 
-from ...presets import preset
+from ...models.support import preset
 from ..core import DIFFERS, agree_if, figure, fmt, lyapunov_text, period_text
 from ._common import IC, JUST_AFTER, method_text
 

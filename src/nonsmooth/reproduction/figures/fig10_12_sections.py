@@ -6,7 +6,7 @@ import math
 
 import numpy as np
 
-from ...presets import preset
+from ...models.support import preset
 from ..access import number, value
 from ..core import DIFFERS, agree_if, figure, fmt, lyapunov_text, period_text, verdict_period
 from ._common import (EXPLORE_ICS, attractor_note, find_orbit, gap, ic_grid, method_text,
@@ -115,7 +115,7 @@ def variant_evidence(ctx, p, ds, label, eta_used):
         alt = run_poincare(ctx, p.replace(eta=1e-5))
         gap(ctx, "eta", f"{label} with eta = 1e-5 instead of {eta_used:g}: {point_summary(alt)} "
                         f"(with {eta_used:g}: {point_summary(ds)})")
-        alt12 = run_poincare(ctx, p, transition="eq12")
+        alt12 = run_poincare(ctx, p, method="smooth_eq12")
         gap(ctx, "eq12", f"{label} with eq. 12: {point_summary(alt12)} "
                          f"(with eq. 13: {point_summary(ds)})")
     except Exception as exc:  # noqa: BLE001
