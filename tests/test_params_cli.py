@@ -163,6 +163,9 @@ def test_eq12_is_a_method_of_the_support_model(tmp_path):
     assert np.max(np.abs(eq13.X.values - lib.X.values)) > 1e-6
     r = _cli("simulate", "--transition", "eq12", "-o", str(tmp_path / "u.nc"))
     assert r.returncode == 2 and "Traceback" not in r.stderr + r.stdout
+    assert r.stderr.strip().splitlines() == ["error: transition: the option is gone; eq. 12 is "
+                                             "the support model's method: --method smooth_eq12 "
+                                             "(eq. 13 is --method smooth)"]
 
 
 def test_simulate_command_writes_netcdf_and_png(tmp_path):

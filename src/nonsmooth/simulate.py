@@ -96,8 +96,9 @@ def simulate(params: ParamsBase, *, periods: int, transient: int = 0,
 
     After ``transient`` whole forcing periods T = 2 pi/omega, the state is sampled at
     t = t0 + k T / samples_per_period, k = 0 ... periods * samples_per_period.
-    ``method="smooth"``: the switch model of eqs. 10-14 (RKF45); ``"exact"``: the non-smooth
-    system of eqs. 4, 7-9 (closed form between located switching events).
+    ``method="smooth"``: the switch model of eqs. 10-14 (RKF45; ``"smooth_eq12"`` with the
+    transition fields of eq. 12); ``"exact"``: the non-smooth system of eqs. 4, 7-9 (closed
+    form between located switching events); another model's methods likewise.
 
     Returns a Dataset with coordinate ``t`` and variables ``X``, ``V``, ``region``
     (0 Gamma-, 1 Sigma_alpha, 2 Sigma_beta, 3 Gamma+; the exact model uses 0 and 3; CF flags),

@@ -175,7 +175,7 @@ def eta_study(params: ParamsBase, etas, *, transient: int = 300, record: int | N
             or "smooth" not in params.model.methods:
         raise ParameterError(f"params: eta_study needs a model with a band eta and both methods "
                              f"smooth and exact (model {params.model.name!r})")
-    if method == "exact" or method not in params.model.methods:
+    if not isinstance(method, str) or method == "exact" or method not in params.model.methods:
         raise ParameterError(f"method: eta_study audits a smoothed method of model "
                              f"{params.model.name!r} (one of: "
                              f"{', '.join(k for k in params.model.methods if k != 'exact')}), "

@@ -11,7 +11,7 @@ import sys
 import typer
 
 from .. import _numba_cache
-from ..errors import IntegrationError, NonsmoothError
+from ..errors import IntegrationError, NonsmoothError, ParameterError
 from .app import EXIT_INTERRUPTED, EXIT_NUMERICAL, EXIT_USAGE, Interrupted, Terminated, app
 from .common import planned
 
@@ -72,8 +72,12 @@ def main(argv: list[str] | None = None) -> None:
     chunks.on_resume = _resume_notice
     previous = signal.signal(signal.SIGTERM, _terminate)
     _numba_cache.compile_notice = _compile_notice
+    args = sys.argv[1:] if argv is None else list(argv)
     try:
-        app(args=argv, prog_name="nonsmooth")
+        if any(a == "--transition" or a.startswith("--transition=") for a in args):
+            raise ParameterError("transition: the option is gone; eq. 12 is the support model's "
+                                 "method: --method smooth_eq12 (eq. 13 is --method smooth)")
+        app(args=args, prog_name="nonsmooth")
     except Interrupted as exc:
         typer.echo(interrupted_message(exc.code), err=True)
         sys.exit(exc.code)

@@ -74,7 +74,8 @@ def load_params(preset: str | None, sets: list[str] | None, model: str = DEFAULT
 
 def _default_preset(m, default_preset: str | None) -> str | None:
     """The command's paper set where ``m`` is the paper's (built-in default) model."""
-    return default_preset if m.name == DEFAULT_MODEL and m.source == "built-in" else None
+    paper = m.name == DEFAULT_MODEL and m.source == "built-in" and default_preset in m.presets
+    return default_preset if paper else None
 
 
 def _without_eta(items) -> list:

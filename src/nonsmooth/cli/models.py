@@ -32,9 +32,10 @@ def model_lines(name: str) -> list[str]:
     out += ["", f"state: {state}",
             "modes: " + ", ".join(f"{i} {nm}" for i, nm in enumerate(m.mode_names)),
             f"contact: {m.contact_name}", "", "methods:"]
+    width = max(map(len, m.methods))
     for k, meth in m.methods.items():
         modes = ", ".join(m.mode_names[i] for i in meth.modes) if meth.modes else "all"
-        out.append(f"  {k:7s} {meth.description or '(no description)'} (modes: {modes})")
+        out.append(f"  {k:{width}s} {meth.description or '(no description)'} (modes: {modes})")
     out += ["", "presets (--preset NAME):"]
     for k, (values, text) in m.presets.items():
         vals = ", ".join(f"{a}={b:g}" for a, b in values.items())
