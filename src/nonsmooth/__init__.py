@@ -24,6 +24,8 @@ _LAZY = {
     "preset": ".models.support", "PRESETS": ".models.support",
     "Solver": ".kernels",
     "model": ".models",
+    "model_from_equations": ".models.equations",
+    "Guard": ".models.equations",
     "simulate": ".simulate",
     "poincare": ".analysis.poincare",
     "bifurcation_diagram": ".analysis.bifurcation",
@@ -42,7 +44,7 @@ _LAZY = {
 _SUBMODULES = ("analysis", "cli", "errors", "integrate", "io", "kernels", "models",
                "plot", "reproduction", "status", "sweep", "chunks")
 
-__all__ = ["__version__", "Params", "PARAM_NAMES", "model", "models", "preset", "PRESETS", "simulate", "reproduce", "Solver",
+__all__ = ["__version__", "Params", "PARAM_NAMES", "model", "models", "model_from_equations", "Guard", "preset", "PRESETS", "simulate", "reproduce", "Solver",
            "eta_study", "lyapunov", "periodic_orbit", "continuation", "two_parameter_curve", "parameter_map", "poincare", "bifurcation_diagram", "resonance_curve", "basins",
            "NonsmoothError", "ParameterError", "OutputError", "IntegrationError"]
 

@@ -1,0 +1,481 @@
+"""Models written as equations: :func:`model_from_equations` turns the states, parameters, the
+vector field of every mode and the switching surfaces with their transitions and resets,
+written as expressions (strings or SymPy), into an ordinary :class:`~nonsmooth.models.base.Model`.
+
+It derives what the model interface (:mod:`nonsmooth.models.base`) asks for by hand:
+
+* the Jacobian of every mode's field (SymPy differentiation, common subexpressions shared);
+* the guards as affine rows: a surface must be affine in the state and in cos(omega t),
+  sin(omega t) (coefficients may depend on the parameters); its coefficients are read off
+  exactly. A surface that is not affine, or whose gradient in the state is zero, is refused
+  with one line naming it;
+* the closed form of linear modes (two states X, V with X' = V and
+  V' = -k X - c V + F cos(omega t) + b, k > 0, coefficients of the parameters only): the
+  ``exact`` method then propagates them exactly, as the built-in models do;
+* ``transition`` (the first branch whose condition holds; resets evaluated with the values
+  before the event) and ``initial`` (the first of the given (condition, mode) pairs that
+  holds, else the first mode whose surfaces are all >= 0, else the first mode).
+
+In expressions: the state and parameter names, ``t`` (the time since the start of the current
+forcing period, so any function of it with period T = 2 pi / omega is a periodic forcing),
+``pi`` and the functions sin, cos, tan, exp, log, sqrt, sinh, cosh, tanh, asin, acos, atan,
+atan2, Abs, sign, Min, Max, floor and Piecewise, and logistic(z) = 1 / (1 + exp(-z)) and
+softplus(y) = log(1 + exp(y)) for regularised laws (evaluated and differentiated without
+overflow). ``cos(omega*t)`` and ``sin(omega*t)`` are
+read from the kernel's rotation, without a transcendental call.
+
+The generated functions are written to a Python file in the package's cache directory, named
+by a digest of the equations and the package version, and compiled by numba with its disk
+cache: a model compiles once per machine (see the README for the times).
+"""
+
+from __future__ import annotations
+
+import hashlib
+import importlib.util
+import keyword
+import sys
+import tempfile
+import warnings
+from dataclasses import dataclass
+from pathlib import Path
+
+from .._version import __version__
+from ..errors import ParameterError
+from .base import Method, Model, Param
+
+#: Functions allowed in expressions (SymPy names), and the two of regularised contact and
+#: friction laws that the package adds: ``logistic(z) = 1 / (1 + exp(-z))`` and
+#: ``softplus(y) = log(1 + exp(y))``, evaluated and differentiated without overflow (their
+#: derivatives are logistic (1 - logistic) and logistic: a Jacobian written with exp would
+#: give inf / inf far from the band).
+FUNCTIONS = ("sin", "cos", "tan", "exp", "log", "sqrt", "sinh", "cosh", "tanh", "asin", "acos",
+             "atan", "atan2", "Abs", "sign", "Min", "Max", "floor", "Piecewise")
+SMOOTH_STEPS = ("logistic", "softplus")
+#: Names the generated code uses itself: a state or parameter may not take them.
+_RESERVED = {"t", "pi", "c", "s", "u", "p", "mem", "du", "J", "G", "k", "mode", "out", "math",
+             *FUNCTIONS, *SMOOTH_STEPS}
+
+
+@dataclass(frozen=True)
+class Guard:
+    """A switching surface of one mode: ``surface`` is >= 0 inside the mode and the mode is
+    left when it turns negative (affine in the state and in cos/sin(omega t)).
+
+    ``to``: the mode entered (a name), or branches ``[(condition, mode), ...]`` or
+    ``[(condition, mode, reset), ...]`` tried in order at the event: the first whose condition
+    holds is taken ("True" for the last, catch-all branch; where none holds the mode is kept,
+    without reset). ``reset``: new values of states at the event, ``{"V": "-r*V"}``, evaluated
+    with the values before it (the default of every branch that gives none)."""
+
+    surface: object
+    to: object
+    reset: dict | None = None
+
+
+def model_from_equations(name: str, *, states, parameters, modes: dict, guards: dict | None = None,
+                         initial=None, method: str = "exact", omega: str = "omega",
+                         forcing_amplitude: str | None = None, description: str = "",
+                         flow_is_homeomorphism: bool = False, closed_form: bool = True,
+                         rtol: float | None = None, atol: float | None = None,
+                         contact_modes=(), **model_kw) -> Model:
+    """A :class:`Model` from equations (see the module documentation).
+
+    ``states``: names, e.g. ``("X", "V")``. ``parameters``: ``{name: default}``,
+    ``{name: Param(...)}`` / ``{name: dict(default=..., low=..., ...)}`` (keywords of
+    :class:`Param`), or a sequence of :class:`Param`. ``modes``: ``{mode name: [d state/dt,
+    ...]}`` (one expression per state, in order). ``guards``: ``{mode name: [Guard, ...]}`` (a
+    tuple ``(surface, to)`` or ``(surface, to, reset)`` is read as a Guard). ``initial``:
+    ``[(condition, mode), ...]`` classifying a state at t = 0 (default: the first mode whose
+    surfaces hold). ``method``: the name of the one method these equations define ("exact"
+    for a non-smooth system, "smooth" for a regularised one). ``omega``: the forcing frequency
+    parameter. ``contact_modes``: mode names that count as contact. Other keywords
+    (``state_units``, ``state_long_names``, ``presets``, ``contact_name``, ``lines``,
+    ``references``, ``check``, ...) go to :class:`Model` as they are.
+
+    Every mistake (an expression that does not parse, an unknown name, a surface that is not
+    affine or has no gradient, a mode that does not exist) is one ParameterError naming the
+    model and the place."""
+    import sympy as sp
+
+    bad = lambda msg: ParameterError(f"model {name}: {msg}")  # noqa: E731
+    states = tuple(states)
+    params = _parameters(parameters, bad)
+    pnames = tuple(q.name for q in params)
+    for nm in states + pnames:
+        if not nm.isidentifier() or keyword.iskeyword(nm) or nm in _RESERVED:
+            raise bad(f"{nm!r} cannot name a state or parameter (reserved or not an identifier)")
+    if len(set(states + pnames)) != len(states) + len(pnames):
+        raise bad("state and parameter names must all differ")
+    if omega not in pnames:
+        raise bad(f"the forcing frequency {omega!r} must be a parameter")
+    mode_names = tuple(modes)
+    if not mode_names:
+        raise bad("at least one mode is needed")
+    n = len(states)
+    sym = {nm: sp.Symbol(nm, real=True) for nm in states + pnames}
+    t = sp.Symbol("t", real=True)
+    C, S = sp.Symbol("_C", real=True), sp.Symbol("_S", real=True)
+    ctx = _Context(sp, sym, t, C, S, sym[omega], set(states), name)
+
+    fields = {}
+    for mname, exprs in modes.items():
+        exprs = list(exprs) if not isinstance(exprs, str) else [exprs]
+        if len(exprs) != n:
+            raise bad(f"mode {mname}: {len(exprs)} expressions for {n} states")
+        fields[mname] = [ctx.parse(e, f"mode {mname}, d{states[i]}/dt")
+                         for i, e in enumerate(exprs)]
+    rows, branches = {}, {}
+    for mname, glist in (guards or {}).items():
+        if mname not in mode_names:
+            raise bad(f"guards: unknown mode {mname!r} (modes: {', '.join(mode_names)})")
+        rows[mname], branches[mname] = [], []
+        for j, g in enumerate(glist):
+            g = g if isinstance(g, Guard) else Guard(*g)
+            where = f"mode {mname}, surface {j}"
+            rows[mname].append(ctx.affine_row(ctx.parse(g.surface, where), where))
+            branches[mname].append(ctx.branches(g, where, mode_names))
+    init = [(ctx.condition(cond, f"initial, condition {i}"), _mode_index(m, mode_names, bad))
+            for i, (cond, m) in enumerate(initial or ())]
+    linear = {m: ctx.linear(fields[m]) for m in mode_names} if closed_form and n == 2 else {}
+
+    source = _source(sp, ctx, states, pnames, mode_names, fields, rows, branches, init, linear)
+    module = _load(name, source)
+    if isinstance(contact_modes, (tuple, list)):
+        contact_modes = sum(1 << _mode_index(m, mode_names, bad) for m in contact_modes)
+    has_linear = any(v is not None for v in linear.values())
+    meth = Method(module.field, module.jacobian, module.guards, module.transition,
+                  module.initial, module.linear if has_linear else None,
+                  closed_form=has_linear, flow_is_homeomorphism=flow_is_homeomorphism,
+                  modes=tuple(range(len(mode_names))), rtol=rtol, atol=atol,
+                  description=description or f"written as equations ({len(mode_names)} modes)")
+    model = Model(name=name, description=description or "a model written as equations",
+                  parameters=params, state_names=states, mode_names=mode_names,
+                  methods={method: meth}, omega=omega, forcing_amplitude=forcing_amplitude,
+                  contact_modes=contact_modes, **model_kw)
+    model.fns(method)  # compile and sample-check now: a malformed model fails here
+    return model
+
+
+_STEPS: dict = {}
+
+
+def _smooth_steps(sp) -> dict:
+    """The SymPy functions ``logistic`` and ``softplus`` (made once: SymPy is imported late)."""
+    if not _STEPS:
+        class logistic(sp.Function):  # noqa: N801 - the name users write
+            def fdiff(self, argindex=1):
+                z = self.args[0]
+                return logistic(z) * (1 - logistic(z))
+
+        class softplus(sp.Function):  # noqa: N801
+            def fdiff(self, argindex=1):
+                return logistic(self.args[0])
+
+        _STEPS.update(logistic=logistic, softplus=softplus)
+    return dict(_STEPS)
+
+
+_HELPERS = """
+@numba.njit(cache=True, inline="always")
+def _logistic(z):
+    if z >= 0.0:
+        return 1.0 / (1.0 + math.exp(-z))
+    e = math.exp(z)
+    return e / (1.0 + e)
+
+
+@numba.njit(cache=True, inline="always")
+def _softplus(y):
+    return max(y, 0.0) + math.log1p(math.exp(-abs(y)))
+
+"""
+
+
+def _parameters(parameters, bad) -> tuple:
+    if isinstance(parameters, dict):
+        out = []
+        for nm, v in parameters.items():
+            if isinstance(v, Param):
+                out.append(v if v.name == nm else Param(**{**v.__dict__, "name": nm}))
+            elif isinstance(v, dict):
+                out.append(Param(nm, **v))
+            else:
+                out.append(Param(nm, v))
+        return tuple(out)
+    out = tuple(parameters)
+    if not all(isinstance(q, Param) for q in out):
+        raise bad("parameters: a dict {name: default | Param | dict} or a sequence of Param")
+    return out
+
+
+def _mode_index(m, mode_names, bad) -> int:
+    if m not in mode_names:
+        raise bad(f"unknown mode {m!r} (modes: {', '.join(mode_names)})")
+    return mode_names.index(m)
+
+
+class _Context:
+    """Parsing and the derivations, for one model."""
+
+    def __init__(self, sp, sym, t, C, S, omega, states, name):
+        self.sp, self.sym, self.t, self.C, self.S = sp, sym, t, C, S
+        self.states = [sym[k] for k in sym if k in states]
+        self.omega, self.name = omega, name
+        self.local = {**sym, "t": t, "pi": sp.pi, **{f: getattr(sp, f) for f in FUNCTIONS},
+                      **_smooth_steps(sp)}
+
+    def bad(self, msg):
+        return ParameterError(f"model {self.name}: {msg}")
+
+    def parse(self, text, where):
+        sp = self.sp
+        if isinstance(text, (int, float)) and not isinstance(text, bool):
+            return sp.Float(text) if isinstance(text, float) else sp.Integer(text)
+        if isinstance(text, sp.Basic):
+            expr = text.xreplace({s: self.local[s.name] for s in text.free_symbols
+                                  if s.name in self.local})
+        elif isinstance(text, str):
+            from sympy.parsing.sympy_parser import parse_expr, standard_transformations
+            try:
+                expr = parse_expr(text, local_dict=dict(self.local),
+                                  global_dict={"Integer": sp.Integer, "Float": sp.Float,
+                                               "Rational": sp.Rational, "Symbol": sp.Symbol},
+                                  transformations=standard_transformations)
+            except Exception as exc:  # noqa: BLE001 - any parse failure is the user's text
+                raise self.bad(f"{where}: cannot parse {text!r} ({type(exc).__name__})") from None
+            if isinstance(expr, (tuple, list)) or not isinstance(expr, sp.Basic):
+                raise self.bad(f"{where}: {text!r} is not an expression")
+        else:
+            raise self.bad(f"{where}: expected an expression (a string or SymPy), got {text!r}")
+        known = set(self.sym.values()) | {self.t}
+        unknown = sorted(s.name for s in expr.free_symbols if s not in known)
+        if unknown:
+            raise self.bad(f"{where}: unknown name {unknown[0]!r} (states and parameters: "
+                           f"{', '.join(k for k in self.sym)}; and t)")
+        w, t = self.omega, self.t
+        return expr.subs({self.sp.cos(w * t): self.C, self.sp.sin(w * t): self.S})
+
+    def condition(self, text, where):
+        """A condition: an expression whose Python ``and`` / ``or`` / ``not`` and chained
+        comparisons (``0 < X < 1``) are read as SymPy's And / Or / Not."""
+        import ast
+        sp = self.sp
+        if not isinstance(text, str):
+            return self.parse(text, where)
+        try:
+            tree = ast.parse(text.strip(), mode="eval").body
+        except SyntaxError:
+            raise self.bad(f"{where}: cannot parse {text!r} (SyntaxError)") from None
+
+        def walk(node):
+            if isinstance(node, ast.BoolOp):
+                parts = [walk(v) for v in node.values]
+                return sp.And(*parts) if isinstance(node.op, ast.And) else sp.Or(*parts)
+            if isinstance(node, ast.UnaryOp) and isinstance(node.op, ast.Not):
+                return sp.Not(walk(node.operand))
+            if isinstance(node, ast.Compare) and len(node.ops) > 1:
+                terms = [node.left, *node.comparators]
+                return sp.And(*(walk(ast.Compare(left=terms[i], ops=[op],
+                                                 comparators=[terms[i + 1]]))
+                                for i, op in enumerate(node.ops)))
+            if isinstance(node, ast.Constant) and isinstance(node.value, bool):
+                return sp.true if node.value else sp.false
+            return self.parse(ast.unparse(node), where)
+        return walk(tree)
+
+    def affine_row(self, g, where):
+        """Coefficients (d/du_i ..., constant, cos, sin) of an affine surface."""
+        sp = self.sp
+        var = self.states + [self.C, self.S]
+        if self.t in g.free_symbols:
+            raise self.bad(f"{where}: a surface may depend on time only through cos(omega t) "
+                           f"and sin(omega t)")
+        coef = [sp.diff(g, v) for v in var]
+        if any(c.free_symbols & set(var) for c in coef):
+            raise self.bad(f"{where}: the surface {g} is not affine in the state and "
+                           f"cos/sin(omega t) (curved surfaces are not supported yet)")
+        if all(sp.simplify(c) == 0 for c in coef[:len(self.states)]):
+            raise self.bad(f"{where}: the surface {g} has a zero gradient in the state")
+        const = g.subs({v: 0 for v in var})
+        n = len(self.states)
+        return coef[:n] + [const, coef[n], coef[n + 1]]
+
+    def branches(self, g, where, mode_names):
+        """[(condition, mode index, {state index: expression}), ...] of a guard."""
+        to = g.to
+        if isinstance(to, str):
+            to = [("True", to, g.reset)]
+        out = []
+        for i, br in enumerate(to):
+            if len(br) not in (2, 3):
+                raise self.bad(f"{where}: a branch is (condition, mode) or (condition, mode, "
+                               f"reset), got {br!r}")
+            cond, mode = br[0], br[1]
+            reset = br[2] if len(br) == 3 and br[2] is not None else g.reset or {}
+            if mode not in mode_names:
+                raise self.bad(f"{where}: unknown mode {mode!r} (modes: {', '.join(mode_names)})")
+            cond = self.sp.true if cond in (True, "True") else self.condition(
+                cond, f"{where}, condition {i}")
+            names = [s.name for s in self.states]
+            rs = {}
+            for k, v in reset.items():
+                if k not in names:
+                    raise self.bad(f"{where}: reset of {k!r}, which is not a state")
+                rs[names.index(k)] = self.parse(v, f"{where}, reset of {k}")
+            out.append((cond, mode_names.index(mode), rs))
+        return out
+
+    def linear(self, f):
+        """(k, c, b, F) where the mode is X' = V, V' = -k X - c V + F cos + b with constant
+        coefficients (k > 0 is checked at run time), else None."""
+        sp = self.sp
+        X, V = self.states
+        if sp.simplify(f[0] - V) != 0:
+            return None
+        a = sp.expand(f[1])
+        var = [X, V, self.C]
+        coef = [sp.diff(a, v) for v in var]
+        if any(c.free_symbols & (set(var) | {self.S, self.t}) for c in coef):
+            return None
+        b = a.subs({v: 0 for v in var})
+        if b.free_symbols & {self.S, self.t}:
+            return None
+        return -coef[0], -coef[1], b, coef[2]
+
+
+def _source(sp, ctx, states, pnames, mode_names, fields, rows, branches, init, linear) -> str:
+    """The Python source of the six model functions."""
+    from sympy.printing.pycode import PythonCodePrinter
+
+    n = len(states)
+    names = {ctx.sym[k]: sp.Symbol(f"_x{i}") for i, k in enumerate(states)}
+    names.update({ctx.sym[k]: sp.Symbol(f"_p{i}") for i, k in enumerate(pnames)})
+    names.update({ctx.t: sp.Symbol("t"), ctx.C: sp.Symbol("c"), ctx.S: sp.Symbol("s")})
+    class Printer(PythonCodePrinter):
+        def _print_logistic(self, e):
+            return f"_logistic({self._print(e.args[0])})"
+
+        def _print_softplus(self, e):
+            return f"_softplus({self._print(e.args[0])})"
+
+    printer = Printer({"fully_qualified_modules": True, "standard": "python3"})
+
+    def plain(e):
+        """Heaviside (the derivative of Max/Min) as a Piecewise the printer writes."""
+        e = sp.sympify(e).xreplace(names)
+        return e.replace(sp.Heaviside, lambda x, *h: sp.Piecewise((0, x < 0), (1, True)))
+
+    def code(e):
+        e = plain(e)
+        if e is sp.true:
+            return "True"
+        if e is sp.false:
+            return "False"
+        return printer.doprint(e)
+
+    unpack_p = [f"    _p{i} = p[{i}]" for i in range(len(pnames))]
+    unpack_u = [f"    _x{i} = u[{i}]" for i in range(n)]
+
+    def by_mode(body_of, indent="    ", default="return 0"):
+        out = []
+        for m, mname in enumerate(mode_names):
+            body = body_of(mname)
+            if body:
+                out.append(f"{indent}{'if' if not out else 'elif'} mode == {m}:")
+                out += [f"{indent}    {ln}" for ln in body]
+        return out + [f"{indent}{default}"]
+
+    def cse_lines(exprs, targets):
+        reps, red = sp.cse([plain(e) for e in exprs],
+                           symbols=sp.numbered_symbols("_w"))
+        out = [f"{v} = {printer.doprint(e)}" for v, e in reps]
+        return out + [f"{tg} = float({printer.doprint(e)})" for tg, e in zip(targets, red)]
+
+    src = ["# generated by nonsmooth.models.equations: do not edit", "import math", "",
+           "import numba", _HELPERS]
+    src += ["def field(mode, t, c, s, u, p, mem, du):", *unpack_u, *unpack_p]
+    src += by_mode(lambda m: cse_lines(fields[m], [f"du[{i}]" for i in range(n)])
+                   + ["return 0"])
+    src += ["", "", "def jacobian(mode, t, c, s, u, p, mem, J):", *unpack_u, *unpack_p]
+    X = [ctx.sym[k] for k in states]
+    src += by_mode(lambda m: cse_lines([sp.diff(f, x) for f in fields[m] for x in X],
+                                       [f"J[{i}, {j}]" for i in range(n) for j in range(n)])
+                   + ["return 0"])
+
+    def guard_body(m):
+        out = []
+        for k, row in enumerate(rows.get(m, ())):
+            cols = list(range(n)) + [n, n + 1, n + 2]
+            out += [f"G[{k}, {col}] = float({code(v)})" for col, v in zip(cols, row)]
+        return out + [f"return {len(rows.get(m, ()))}"] if out else []
+
+    src += ["", "", "def guards(mode, p, mem, G):", *unpack_p]
+    src += by_mode(guard_body)
+
+    def transition_body(m):
+        out = []
+        for k, brs in enumerate(branches.get(m, ())):
+            out.append(f"{'if' if not out else 'elif'} k == {k}:")
+            for cond, new, reset in brs:
+                out.append(f"    if {code(cond)}:")
+                tmp = [f"        _r{i} = float({code(e)})" for i, e in reset.items()]
+                out += tmp + [f"        u[{i}] = _r{i}" for i in reset] + [f"        return {new}"]
+        return out + ["return mode"] if out else []
+
+    src += ["", "", "def transition(mode, k, t, c, s, u, p, mem):", *unpack_u, *unpack_p]
+    src += by_mode(transition_body, default="return mode")
+
+    src += ["", "", "def initial(c, s, u, p, mem):", "    t = 0.0", *unpack_u, *unpack_p]
+    src += [f"    if {code(cond)}:\n        return {m}" for cond, m in init]
+    for m, mname in enumerate(mode_names):
+        tests = []
+        for row in rows.get(mname, ()):
+            g = sum((row[i] * X[i] for i in range(n)), sp.Integer(0)) + row[n] \
+                + row[n + 1] * ctx.C + row[n + 2] * ctx.S
+            tests.append(f"({code(g)}) >= 0.0")
+        src.append(f"    if {' and '.join(tests) or 'True'}:\n        return {m}")
+    src += ["    return 0"]
+
+    def linear_body(m):
+        lin = linear.get(m)
+        if lin is None:
+            return []
+        return [f"out[{i}] = float({code(v)})" for i, v in enumerate(lin)] + \
+            ["return 1 if out[0] > 0.0 else 0"]
+
+    src += ["", "", "def linear(mode, p, out):", *unpack_p]
+    src += by_mode(linear_body)
+    return "\n".join(src) + "\n"
+
+
+def _load(name: str, source: str):
+    """Write ``source`` to the cache directory (named by its digest) and import it: numba
+    caches the compiled functions of a module with a file."""
+    from .._numba_cache import cache_base
+    digest = hashlib.sha256((__version__ + source).encode()).hexdigest()[:16]
+    safe = "".join(ch if ch.isalnum() else "_" for ch in name)
+    base = cache_base()
+    if base is None:
+        warnings.warn(f"model {name}: no writable cache directory; its functions compile on "
+                      f"every run", stacklevel=3)
+        base = Path(tempfile.mkdtemp(prefix="nonsmooth-eq-"))
+    folder = base.parent / "equations" if base.name == "numba" else base / "equations"
+    path = folder / f"{safe}_{digest}.py"
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+        if not path.exists() or path.read_text() != source:
+            tmp = path.with_suffix(f".tmp{id(source)}")
+            tmp.write_text(source)
+            tmp.replace(path)
+    except OSError as exc:
+        raise ParameterError(f"model {name}: cannot write its generated functions to "
+                             f"{folder} ({exc.strerror or exc})") from None
+    modname = f"nonsmooth_equations_{safe}_{digest}"
+    if modname in sys.modules:
+        return sys.modules[modname]
+    spec = importlib.util.spec_from_file_location(modname, path)
+    module = importlib.util.module_from_spec(spec)
+    sys.modules[modname] = module
+    spec.loader.exec_module(module)
+    return module

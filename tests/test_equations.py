@@ -1,0 +1,169 @@
+"""Models written as equations (``ns.model_from_equations``): the same numbers as the same
+models written by hand, closed forms derived for linear modes, any periodic forcing through
+the period's local time, tangent dynamics, and one-line errors for bad equations."""
+
+import math
+
+import numpy as np
+import pytest
+from scipy.integrate import solve_ivp
+
+import nonsmooth as ns
+from nonsmooth.errors import ParameterError
+
+pytestmark = pytest.mark.filterwarnings("ignore::numba.NumbaExperimentalFeatureWarning")
+
+FREE_DUFFING = "-xi*V - X - beta*X**3 + F0*cos(omega*t)"
+SUPPORT_FORCE = "k_s*(X - gap) + c_s*V"
+
+
+def one_sided_duffing():
+    """The README's one-sided Duffing example (examples/one_sided_duffing.py, exact method)
+    written as equations: its memory slot (free above the gap after a separation) becomes a
+    third mode."""
+    return ns.model_from_equations(
+        "duffing_equations", states=("X", "V"),
+        parameters={"xi": 0.1, "beta": 0.5, "F0": 1.0,
+                    "omega": dict(default=1.2, low=0.0, low_open=True), "gap": 1.0,
+                    "k_s": dict(default=20.0, low=0.0, low_open=True),
+                    "c_s": dict(default=0.2, low=0.0)},
+        modes={"free": ["V", FREE_DUFFING],
+               "contact": ["V", f"{FREE_DUFFING} - ({SUPPORT_FORCE})"],
+               "above": ["V", FREE_DUFFING]},
+        guards={"free": [("gap - X", [("V > 0", "contact"), (True, "above")])],
+                "contact": [(SUPPORT_FORCE, [("X > gap", "above"), (True, "free")])],
+                "above": [(f"-({SUPPORT_FORCE})", "contact"), ("X - gap", "free")]},
+        initial=[(f"X > gap and {SUPPORT_FORCE} > 0", "contact"), ("X > gap", "above")],
+        method="exact", rtol=1e-12, atol=1e-14, contact_modes=("contact",))
+
+
+def impact_oscillator():
+    """Newton's impact law at X = 1, without chatter resolution (orbits with one impact per
+    period only)."""
+    return ns.model_from_equations(
+        "impact_equations", states=("X", "V"),
+        parameters={"omega0": 1.0, "xi": 0.05, "F0": 3.0, "omega": 1.5,
+                    "r": dict(default=0.8, low=0.0, high=1.0)},
+        modes={"free": ["V", "-omega0**2*X - xi*V + F0*cos(omega*t)"]},
+        guards={"free": [ns.Guard("1 - X", "free", reset={"V": "-r*V"})]},
+        method="exact", flow_is_homeomorphism=True)
+
+
+def test_equations_reproduce_the_hand_written_example():
+    eq = one_sided_duffing()
+    hand = ns.model("examples/one_sided_duffing.py:MODEL")
+    assert eq.mode_names == ("free", "contact", "above") and eq.contact_modes == 0b10
+    a = ns.simulate(eq.params(), periods=20, transient=10, method="exact", samples_per_period=20)
+    b = ns.simulate(hand.params(), periods=20, transient=10, method="exact",
+                    samples_per_period=20)
+    assert float(a.max_X) > 1.0  # contact happens
+    np.testing.assert_allclose(a.X.values, b.X.values, rtol=0, atol=1e-10)
+    np.testing.assert_allclose(a.V.values, b.V.values, rtol=0, atol=1e-10)
+    assert float(a.max_X) == pytest.approx(float(b.max_X), abs=1e-10)
+
+
+def test_linear_mode_gets_its_closed_form_and_matches_the_built_in_impact_model():
+    eq = impact_oscillator()
+    meth = eq.methods["exact"]
+    assert meth.closed_form and meth.linear is not None
+    values = dict(omega0=1.0, xi=0.05, F0=3.0, omega=1.5, r=0.8)
+    a = ns.simulate(eq.params(**values), periods=30, transient=100, method="exact")
+    b = ns.simulate(ns.model("impact").params(**values), periods=30, transient=100,
+                    method="exact")
+    np.testing.assert_allclose(a.X.values, b.X.values, rtol=0, atol=1e-9)
+    np.testing.assert_allclose(a.V.values, b.V.values, rtol=0, atol=1e-9)
+    assert float(a.max_X) == pytest.approx(1.0, abs=1e-12)  # the stop is reached, not passed
+    # the same Floquet multipliers of the period-1 orbit (tangent dynamics with saltation)
+    oa = ns.periodic_orbit(eq.params(**values), x0=0.0, v0=0.0, transient=100, method="exact")
+    ob = ns.periodic_orbit(ns.model("impact").params(**values), x0=0.0, v0=0.0, transient=100,
+                           method="exact")
+    assert int(oa.converged) == 1 and int(ob.converged) == 1
+    np.testing.assert_allclose(np.sort(oa.multiplier_abs.values),
+                               np.sort(ob.multiplier_abs.values), rtol=1e-8)
+
+
+def test_regularised_law_with_logistic_and_softplus_matches_the_example_and_its_tangent():
+    """The example's smooth method (a regularised support force): the derived Jacobian of
+    logistic and softplus stays finite far from the band (a Jacobian of the same law written
+    with exp overflows to inf / inf there), and the Floquet multipliers agree."""
+    force = ("logistic((X - gap)/eta) * k_s*eta*softplus((k_s*(X - gap) + c_s*V)/(k_s*eta))")
+    eq = ns.model_from_equations(
+        "duffing_smooth_equations", states=("X", "V"),
+        parameters={"xi": 0.1, "beta": 0.5, "F0": 1.0, "omega": 1.2, "gap": 1.0,
+                    "k_s": 20.0, "c_s": 0.2, "eta": 1e-3},
+        modes={"free": ["V", f"{FREE_DUFFING} - {force}"],
+               "contact": ["V", f"{FREE_DUFFING} - {force}"]},
+        guards={"free": [("gap - X", "contact")], "contact": [("X - gap", "free")]},
+        initial=[("X >= gap", "contact")], method="smooth", contact_modes=("contact",))
+    hand = ns.model("examples/one_sided_duffing.py:MODEL")
+    a = ns.simulate(eq.params(), periods=20, transient=10, method="smooth", samples_per_period=20)
+    b = ns.simulate(hand.params(), periods=20, transient=10, method="smooth",
+                    samples_per_period=20)
+    np.testing.assert_allclose(a.X.values, b.X.values, rtol=0, atol=1e-9)
+    oa = ns.periodic_orbit(eq.params(), x0=0.1, transient=200, method="smooth")
+    ob = ns.periodic_orbit(hand.params(), x0=0.1, transient=200, method="smooth")
+    assert int(oa.converged) == 1 and int(ob.converged) == 1
+    np.testing.assert_allclose(np.sort(oa.multiplier_abs.values),
+                               np.sort(ob.multiplier_abs.values), rtol=1e-6)
+
+
+def test_any_periodic_forcing_through_the_local_time():
+    """Two harmonics and a constant load on a linear oscillator (no surfaces): the model reads
+    cos(2 omega t) from the period's local time; scipy integrates the same equation."""
+    m = ns.model_from_equations(
+        "two_harmonics", states=("X", "V"),
+        parameters={"xi": 0.1, "F0": 1.0, "F1": 0.5, "omega": 1.3, "b": 0.2},
+        modes={"free": ["V", "-X - xi*V + F0*cos(omega*t) + F1*sin(2*omega*t) + b"]},
+        method="smooth")
+    assert not m.methods["smooth"].closed_form  # sin(2 omega t) is not of the closed form
+    p = m.params()
+    ds = ns.simulate(p, periods=5, method="smooth", samples_per_period=8, rtol=1e-11,
+                     atol=1e-13)
+    T = 2 * math.pi / 1.3
+
+    def rhs(t, y):
+        return [y[1], -y[0] - 0.1 * y[1] + math.cos(1.3 * t) + 0.5 * math.sin(2.6 * t) + 0.2]
+    ref = solve_ivp(rhs, (0, 5 * T), [0.0, 0.0], rtol=1e-12, atol=1e-13, method="DOP853",
+                    t_eval=ds.t.values)
+    np.testing.assert_allclose(ds.X.values, ref.y[0], atol=1e-8)
+
+
+@pytest.mark.parametrize("change, needle", [
+    (dict(modes={"free": ["V", "-X + foo"]}), "mode free, dV/dt: unknown name 'foo'"),
+    (dict(modes={"free": ["V", "-X +* 2"]}), "mode free, dV/dt: cannot parse"),
+    (dict(modes={"free": ["V"]}), "mode free: 1 expressions for 2 states"),
+    (dict(guards={"free": [("1 - X**2", "free")]}), "not affine"),
+    (dict(guards={"free": [("1 + 0*X", "free")]}), "zero gradient"),
+    (dict(guards={"free": [("1 - X", "nowhere")]}), "unknown mode 'nowhere'"),
+    (dict(guards={"gone": [("1 - X", "free")]}), "guards: unknown mode 'gone'"),
+    (dict(guards={"free": [("1 - X*cos(omega*t)", "free")]}), "not affine"),
+    (dict(parameters={"omega": 1.0, "t": 2.0}), "'t' cannot name"),
+    (dict(parameters={"xi": 1.0}), "forcing frequency 'omega' must be a parameter"),
+])
+def test_bad_equations_are_one_line_errors(change, needle):
+    kw = dict(states=("X", "V"), parameters={"omega": 1.0, "xi": 0.1},
+              modes={"free": ["V", "-X - xi*V + cos(omega*t)"]})
+    kw.update(change)
+    with pytest.raises(ParameterError) as exc:
+        ns.model_from_equations("bad", **kw)
+    msg = str(exc.value)
+    assert msg.startswith("model bad: ") and needle in msg and "\n" not in msg
+
+
+def test_a_model_file_of_equations_runs_from_the_cli(tmp_path):
+    import subprocess
+    import sys
+    f = tmp_path / "impact_eq.py"
+    f.write_text(
+        "import nonsmooth as ns\n"
+        "MODEL = ns.model_from_equations('impact_eq', states=('X', 'V'),\n"
+        "    parameters={'xi': 0.05, 'F0': 3.0, 'omega': 1.5, 'r': 0.8},\n"
+        "    modes={'free': ['V', '-X - xi*V + F0*cos(omega*t)']},\n"
+        "    guards={'free': [ns.Guard('1 - X', 'free', reset={'V': '-r*V'})]})\n")
+    r = subprocess.run([sys.executable, "-m", "nonsmooth.cli", "poincare", "--model",
+                        f"{f}:MODEL", "--method", "exact", "--record", "20", "--transient",
+                        "100", "-o", str(tmp_path / "p.nc")], capture_output=True, text=True,
+                       timeout=300)
+    assert r.returncode == 0, r.stderr
+    ds = ns.io.load_dataset(tmp_path / "p.nc")
+    assert int(ds.period) == 1 and ds.attrs["model"] == "impact_eq"
