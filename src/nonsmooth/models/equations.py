@@ -52,6 +52,9 @@ from .base import Method, Model, Param
 FUNCTIONS = ("sin", "cos", "tan", "exp", "log", "sqrt", "sinh", "cosh", "tanh", "asin", "acos",
              "atan", "atan2", "Abs", "sign", "Min", "Max", "floor", "Piecewise")
 SMOOTH_STEPS = ("logistic", "softplus")
+#: Tolerances an ``exact`` method enforces where a mode has no closed form (as the built-in
+#: models do): its RKF45 pieces are then accurate to round-off, not to the solver's rtol.
+EXACT_RTOL, EXACT_ATOL = 1e-12, 1e-14
 #: Names the generated code uses itself: a state or parameter may not take them.
 _RESERVED = {"t", "pi", "c", "s", "u", "p", "mem", "du", "J", "G", "k", "mode", "out", "math",
              *FUNCTIONS, *SMOOTH_STEPS}
@@ -85,7 +88,9 @@ def model_from_equations(name: str, *, states, parameters, modes: dict, guards: 
     ``{name: Param(...)}`` / ``{name: dict(default=..., low=..., ...)}`` (keywords of
     :class:`Param`), or a sequence of :class:`Param`. ``modes``: ``{mode name: [d state/dt,
     ...]}`` (one expression per state, in order). ``guards``: ``{mode name: [Guard, ...]}`` (a
-    tuple ``(surface, to)`` or ``(surface, to, reset)`` is read as a Guard). ``initial``:
+    tuple ``(surface, to)`` or ``(surface, to, reset)`` is read as a Guard). ``rtol``/``atol``:
+    the tolerances the method enforces at most (default for an "exact" method with a mode
+    that has no closed form: :data:`EXACT_RTOL`, :data:`EXACT_ATOL`). ``initial``:
     ``[(condition, mode), ...]`` classifying a state at t = 0 (default: the first mode whose
     surfaces hold). ``method``: the name of the one method these equations define ("exact"
     for a non-smooth system, "smooth" for a regularised one). ``omega``: the forcing frequency
@@ -144,6 +149,9 @@ def model_from_equations(name: str, *, states, parameters, modes: dict, guards: 
     if isinstance(contact_modes, (tuple, list)):
         contact_modes = sum(1 << _mode_index(m, mode_names, bad) for m in contact_modes)
     has_linear = any(v is not None for v in linear.values())
+    if method == "exact" and rtol is None and atol is None \
+            and not all(linear.get(m) is not None for m in mode_names):
+        rtol, atol = EXACT_RTOL, EXACT_ATOL  # nonlinear modes of an exact method: RKF45, tight
     meth = Method(module.field, module.jacobian, module.guards, module.transition,
                   module.initial, module.linear if has_linear else None,
                   closed_form=has_linear, flow_is_homeomorphism=flow_is_homeomorphism,
