@@ -530,7 +530,7 @@ def solver_spec(solver) -> dict:
     m = solver.model
     ref = m.name if m.source == "built-in" else m.source
     return {"model": ref, "method": solver.method, "rtol": solver.rtol, "atol": solver.atol,
-            "max_steps": solver.max_steps,
+            "max_steps": solver.max_steps, "section_phase": solver.section_phase,
             "defined_in_process": m.source == "built-in" and _not_builtin(m)}
 
 
@@ -558,7 +558,7 @@ def solver_from_spec(spec: dict):
     else:
         m = get_model(spec["model"])
     return Solver(model=m, method=spec["method"], rtol=spec["rtol"], atol=spec["atol"],
-                  max_steps=spec["max_steps"])
+                  max_steps=spec["max_steps"], section_phase=spec.get("section_phase", 0.0))
 
 
 def plan_solver(solver, engine) -> dict:

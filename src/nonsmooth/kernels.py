@@ -32,6 +32,7 @@ from .integrate.contract import (
     OPT_N,
     OPT_NMEM,
     OPT_OMEGA,
+    OPT_PHASE,
     OPT_RTOL,
     OPT_VARIANT,
     ST_EXTRA,
@@ -117,13 +118,17 @@ class Solver:
     """How trajectories of ``model`` (default: the paper's ``support``) are computed:
     ``method`` one of the model's methods ("smooth": a switch model, RKF45; "exact":
     non-smooth, event-driven; support also has "smooth_eq12"); tolerances; ``max_steps`` per
-    forcing period before giving up."""
+    forcing period before giving up; ``section_phase``: the forcing phase psi = omega t_s
+    (radians, 0 <= psi < 2 pi) at which periods start, so the stroboscopic section is
+    t = t_s + kT and a trajectory starts at t_s (the generic kernel runs a model whose
+    specialised kernels know only psi = 0)."""
 
     method: str = "smooth"
     rtol: float = 1e-8
     atol: float = 1e-10
     max_steps: int = 200_000
     model: object = None
+    section_phase: float = 0.0
 
     def __post_init__(self):
         from .models import model as get_model
@@ -135,6 +140,12 @@ class Solver:
                 raise ParameterError(f"{name}: must satisfy 0 < {name} < 1, got {v!r}")
         if not (isinstance(self.max_steps, int) and self.max_steps > 0):
             raise ParameterError(f"max_steps: must be a positive integer, got {self.max_steps!r}")
+        ph = self.section_phase
+        if isinstance(ph, bool) or not isinstance(ph, (int, float, np.floating, np.integer)) \
+                or not (math.isfinite(ph) and 0.0 <= ph < 2.0 * math.pi):
+            raise ParameterError(f"section_phase: must satisfy 0 <= section_phase < 2 pi "
+                                 f"(radians), got {ph!r}")
+        object.__setattr__(self, "section_phase", float(ph))
 
     @property
     def spec(self):
@@ -143,8 +154,8 @@ class Solver:
 
     @property
     def code(self) -> int:
-        """Kernel code for :func:`run`."""
-        return self.spec.kernel
+        """Kernel code for :func:`run` (the generic kernel at a section phase other than 0)."""
+        return self.spec.kernel if self.section_phase == 0.0 else KERNEL_GENERIC
 
     @property
     def fns(self) -> tuple:
@@ -172,16 +183,18 @@ class Solver:
         o[OPT_N] = self.model.n
         o[OPT_NMEM] = self.model.n_memory
         o[OPT_CLOSED_FORM] = 1.0 if m.closed_form else 0.0
+        o[OPT_PHASE] = self.section_phase
         return o
 
     def attrs(self) -> dict:
         m = self.spec
         o = self.opts()
         a = {"model": self.model.name, "method": self.method, "rtol": float(o[OPT_RTOL]),
-             "atol": float(o[OPT_ATOL]), "max_steps_per_period": int(self.max_steps)}
-        if m.kernel == KERNEL_SUPPORT_SMOOTH:
+             "atol": float(o[OPT_ATOL]), "max_steps_per_period": int(self.max_steps),
+             "section_phase": self.section_phase}
+        if self.code == KERNEL_SUPPORT_SMOOTH:
             a["integrator"] = smooth_integrator()
-        elif m.kernel == KERNEL_SUPPORT_EXACT:
+        elif self.code == KERNEL_SUPPORT_EXACT:
             a["integrator"] = "closed form between located switching events"
         else:
             a["integrator"] = m.description or generic_integrator(m.closed_form)

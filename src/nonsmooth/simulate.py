@@ -47,14 +47,14 @@ def check_params(params) -> ParamsBase:
     return params
 
 
-def start_trajectory(params, x0, v0, method, rtol, atol):
+def start_trajectory(params, x0, v0, method, rtol, atol, section_phase=0.0):
     """Validated single-trajectory set-up: (params, solver, packed params, kernel opts, initial
     kernel state). Every error names its field."""
     params = check_params(params)
     x0 = check_float("x0", x0)
     v0 = check_float("v0", v0)
-    solver = Solver(method=method, rtol=rtol, atol=atol,
-                    model=params.model)
+    solver = Solver(method=method, rtol=rtol, atol=atol, model=params.model,
+                    section_phase=section_phase)
     return params, solver, params.pack(), solver.opts(), new_state(x0, v0)
 
 
@@ -91,8 +91,9 @@ _SAMPLE_BYTES = 5 * 8 + 2
 def simulate(params: ParamsBase, *, periods: int, transient: int = 0,
              samples_per_period: int = SAMPLES_PER_PERIOD, x0: float = 0.0, v0: float = 0.0,
              method: str = "smooth", rtol: float = 1e-8, atol: float = 1e-10,
-             progress=None) -> xr.Dataset:
-    """Integrate one trajectory from (x0, v0) at t = 0 (forcing phase 0).
+             progress=None, section_phase: float = 0.0) -> xr.Dataset:
+    """Integrate one trajectory from (x0, v0) at t = 0 (forcing phase 0; at
+    t = section_phase / omega with ``section_phase``, the forcing phase in radians).
 
     After ``transient`` whole forcing periods T = 2 pi/omega, the state is sampled at
     t = t0 + k T / samples_per_period, k = 0 ... periods * samples_per_period.
@@ -115,7 +116,8 @@ def simulate(params: ParamsBase, *, periods: int, transient: int = 0,
     progress = progress_callback(progress, "simulate")
     from .io import check_memory, flag_attrs, format_bytes
     from .sweep import run_trajectories
-    params, solver, p, opts, state = start_trajectory(params, x0, v0, method, rtol, atol)
+    params, solver, p, opts, state = start_trajectory(params, x0, v0, method, rtol, atol,
+                                                      section_phase)
     periods = check_int("periods", periods, 1)
     transient = check_int("transient", transient, 0)
     spp = check_int("samples_per_period", samples_per_period, 1)
@@ -146,7 +148,7 @@ def simulate(params: ParamsBase, *, periods: int, transient: int = 0,
     Xmax = np.concatenate([[state[0]], rec["Xmax"][0]])
     Xmin = np.concatenate([[state[0]], rec["Xmin"][0]])
     T = params.period
-    t0 = transient * T
+    t0 = transient * T + solver.section_phase / getattr(params, params.model.omega)
     t = t0 + np.arange(n + 1) * (T / spp)
     modes = params.model.mode_names
     regions = flag_attrs(modes, dtype=np.int8)

@@ -494,7 +494,7 @@ def bifurcation_diagram(params: ParamsBase, param: str, values, *, sweep: str = 
                         atol: float = 1e-10, settle: bool = True,
                         max_steps: int = 200_000, workers: int | None = None,
                         progress=None, lyapunov: bool | None = None, store=None,
-                        engine=None) -> xr.Dataset:
+                        engine=None, section_phase: float = 0.0) -> xr.Dataset:
     """Orbit diagram of the stroboscopic section over ``param`` (any parameter of the model:
     omega, F0, omega_s, xi, xi_s, omega0, eta for support) at ``values`` (sorted ascending; each
     validated by the model).
@@ -543,7 +543,7 @@ def bifurcation_diagram(params: ParamsBase, param: str, values, *, sweep: str = 
     x0 = check_float("x0", x0)
     v0 = check_float("v0", v0)
     solver = Solver(model=params.model, method=method, rtol=rtol, atol=atol,
-                    max_steps=max_steps)
+                    max_steps=max_steps, section_phase=section_phase)
     directions = {"up": ["up"], "down": ["down"], "both": ["up", "down"], "fresh": ["fresh"]}[sweep]
     from .stability import wants_lyapunov
     out = run_branches(params, param, values, solver, directions=directions,

@@ -175,7 +175,7 @@ def continuation(params, param: str, *, start=None, k: int = 1, x0: float = 0.0,
                  v0: float = 0.0, transient: int = 0, direction: str = "up", step: float = 0.01,
                  max_step: float | None = None, bounds=None, max_points: int = 400,
                  method: str = "exact", tol: float = 1e-10, rtol: float = 1e-10,
-                 atol: float = 1e-12) -> xr.Dataset:
+                 atol: float = 1e-12, section_phase: float = 0.0) -> xr.Dataset:
     """Follow a branch of k-periodic orbits in ``param`` from ``params``.
 
     The first point is the orbit Newton's shooting finds from (x0, v0) (after ``transient``
@@ -194,7 +194,8 @@ def continuation(params, param: str, *, start=None, k: int = 1, x0: float = 0.0,
     over ``special`` (``special_type`` with CF flags, ``special_<param>``, the multiplier
     nearest the crossing and the point index after which it lies); attrs ``status`` (why the
     branch ended)."""
-    params, solver, p0, opts, state = start_trajectory(params, x0, v0, method, rtol, atol)
+    params, solver, p0, opts, state = start_trajectory(params, x0, v0, method, rtol, atol,
+                                                       section_phase)
     if not isinstance(param, str):
         raise ParameterError(f"param: expected a parameter name, got {param!r}")
     param = params.model.param(param).name
@@ -228,7 +229,8 @@ def continuation(params, param: str, *, start=None, k: int = 1, x0: float = 0.0,
     br = _Branch(setup, p0, index, k, tol, level)
 
     if start is not None:
-        orb, lam0, k, direction = _doubled_orbit(params, param, start, method, tol, rtol, atol)
+        orb, lam0, k, direction = _doubled_orbit(params, param, start, method, tol, rtol, atol,
+                                                       section_phase)
         if not lo <= lam0 <= hi:
             raise ParameterError(f"bounds: ({lo:g}, {hi:g}) exclude the period doubling at "
                                  f"{param} = {lam0:g}")
@@ -237,7 +239,8 @@ def continuation(params, param: str, *, start=None, k: int = 1, x0: float = 0.0,
         br = _Branch(setup, p0, index, k, tol, level)
     else:
         orb = periodic_orbit(params, k=k, x0=x0, v0=v0, method=method, transient=transient,
-                             tol=tol, rtol=rtol, atol=atol, samples_per_period=1)
+                             tol=tol, rtol=rtol, atol=atol, samples_per_period=1,
+                             section_phase=section_phase)
         if orb.attrs["status"] != "converged":
             raise ParameterError(f"start: no period-{k} orbit found from (x0, v0) = ({x0:g}, "
                                  f"{v0:g}) at {param} = {lam0:g} ({orb.attrs['status']}); try "
@@ -285,7 +288,7 @@ def continuation(params, param: str, *, start=None, k: int = 1, x0: float = 0.0,
     return _dataset(params, solver, param, k, pts, specials, status, N, direction, bounds)
 
 
-def _doubled_orbit(params, param, start, method, tol, rtol, atol):
+def _doubled_orbit(params, param, start, method, tol, rtol, atol, section_phase=0.0):
     """Branch switching at a period doubling: (the 2k orbit's periodic_orbit Dataset, its
     parameter value, 2k, direction away from the PD)."""
     try:
@@ -304,7 +307,7 @@ def _doubled_orbit(params, param, start, method, tol, rtol, atol):
     z = np.array([float(src.special_X_section[i]), float(src.special_V_section[i])])
     base = params.replace(**{param: lam})
     orb = periodic_orbit(base, k=k, x0=z[0], v0=z[1], method=method, tol=tol, rtol=rtol,
-                         atol=atol, samples_per_period=1)
+                         atol=atol, samples_per_period=1, section_phase=section_phase)
     M = orb.monodromy.values[:2, :2]
     w, V = np.linalg.eig(M)
     v = np.real(V[:, int(np.argmin(np.abs(w + 1.0)))])
@@ -317,7 +320,7 @@ def _doubled_orbit(params, param, start, method, tol, rtol, atol):
                 zt = z + amp * scale * v
                 o2 = periodic_orbit(params.replace(**{param: lam_t}), k=2 * k, x0=zt[0],
                                     v0=zt[1], method=method, tol=tol, rtol=rtol, atol=atol,
-                                    samples_per_period=1)
+                                    samples_per_period=1, section_phase=section_phase)
                 if o2.attrs["status"] != "converged":
                     continue
                 xs, vs = o2.X_section.values, o2.V_section.values
@@ -460,7 +463,7 @@ def _dataset(params, solver, param, k, pts, specials, status, N, direction, boun
 def two_parameter_curve(params, param: str, param2: str, values2, *, special: str = "fold",
                         k: int = 1, x0: float = 0.0, v0: float = 0.0, bounds=None,
                         step: float = 0.01, max_points: int = 400, method: str = "exact",
-                        tol: float = 1e-10) -> xr.Dataset:
+                        tol: float = 1e-10, section_phase: float = 0.0) -> xr.Dataset:
     """A curve of special points in two parameters: for each value of ``param2`` in
     ``values2``, the branch in ``param`` is continued from the same start (``params``' value
     of ``param``, Newton from (x0, v0)) over ``bounds`` and every located point of type
@@ -489,7 +492,8 @@ def two_parameter_curve(params, param: str, param2: str, values2, *, special: st
     for v in values2:
         p = params.replace(**{param2: float(v)})
         br = continuation(p, param, k=k, x0=x0, v0=v0, bounds=bounds, step=step,
-                          max_points=max_points, method=method, tol=tol)
+                          max_points=max_points, method=method, tol=tol,
+                          section_phase=section_phase)
         sel = br.special_type.values == typ
         lam = br[f"special_{param}"].values[sel]
         mu = (br.special_multiplier_real.values + 1j * br.special_multiplier_imag.values)[sel]

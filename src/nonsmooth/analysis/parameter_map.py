@@ -110,7 +110,8 @@ def parameter_map(params: ParamsBase, x=("omega", 0.8, 1.0, 100), y=("F0", 0.15,
                   atol: float = 1e-10, settle: bool = True,
                   max_steps: int = 200_000, lyapunov: bool | None = None,
                   workers: int | None = None, progress=None, store=None,
-                  engine=None, chunk: int | None = None) -> xr.Dataset:
+                  engine=None, chunk: int | None = None,
+                  section_phase: float = 0.0) -> xr.Dataset:
     """Map of the settled motion over a grid of two parameters (see the module docstring).
 
     ``x``, ``y``: (parameter, min, max, n) of the two axes (any parameters of the model, n >= 1
@@ -157,7 +158,7 @@ def parameter_map(params: ParamsBase, x=("omega", 0.8, 1.0, 100), y=("F0", 0.15,
                  f"a {ny} x {nx} map holds {nx * ny} points; use fewer points per axis",
                  size=(nx, 1))
     solver = Solver(model=params.model, method=method, rtol=rtol, atol=atol,
-                    max_steps=max_steps)
+                    max_steps=max_steps, section_phase=section_phase)
     lyap = wants_lyapunov(lyapunov, solver)
     if chunk is not None:
         chunk = check_int("chunk", chunk, 1)

@@ -8,7 +8,8 @@ the section like the bifurcation and resonance sweeps (``bifurcation.summarize``
 
 Definitions
 -----------
-* Section: the state (X, V) at t_section = kT, k = transient + 1 ... transient + record
+* Section: the state (X, V) at t_section = t_s + kT, k = transient + 1 ... transient + record
+  (t_s = section_phase / omega, 0 by default)
   (forcing phase 0).
 * ``period``: the smallest p <= 64 such that every recorded section point repeats after p
   periods within ``section_tolerance(rtol, atol, scale)`` (scale = largest |X|, |V| seen), i.e.
@@ -240,8 +241,10 @@ def poincare(params: ParamsBase, *, record: int | None = None, transient: int, x
              v0: float = 0.0, method: str = "smooth", rtol: float = 1e-8, atol: float = 1e-10,
              orbit_samples: int = 200, orbit_periods: int | None = None,
              settle: bool = False, progress=None, points: int | None = None,
-             lyapunov: bool | None = None) -> xr.Dataset:
-    """Stroboscopic Poincaré section of one trajectory from (x0, v0) at t = 0.
+             lyapunov: bool | None = None, section_phase: float = 0.0) -> xr.Dataset:
+    """Stroboscopic Poincaré section of one trajectory from (x0, v0) at t = 0 (at the forcing
+    phase ``section_phase``, radians: the section is then t = t_s + kT, omega t_s = that
+    phase).
 
     Integrates ``transient`` forcing periods (all of them unless ``settle=True``), then records
     ``record`` section points X[n], V[n] at t_section = (transient + n + 1) T (``points`` is
@@ -272,7 +275,8 @@ def poincare(params: ParamsBase, *, record: int | None = None, transient: int, x
     from ..sweep import run_trajectories
     from .bifurcation import follow, summarize
     record = renamed("record", record, "points", points)
-    params, solver, p, opts, state = start_trajectory(params, x0, v0, method, rtol, atol)
+    params, solver, p, opts, state = start_trajectory(params, x0, v0, method, rtol, atol,
+                                                      section_phase)
     x0, v0 = float(state[0]), float(state[1])
     record = check_int("record", record, 1)
     transient = check_int("transient", transient, 0)
@@ -313,6 +317,7 @@ def poincare(params: ParamsBase, *, record: int | None = None, transient: int, x
     if wants_lyapunov(lyapunov, solver):
         extra = lyapunov_variables(p[None, :], solver, out["S"][0], record,
                                    np.array([period]), ())
+    ts = solver.section_phase * T / (2.0 * np.pi)  # the section's time in a period
     ds = xr.Dataset(
         {
             "X": ("n", X, {"long_name": "section displacement X(t_section)", "units": "1"}),
@@ -336,9 +341,10 @@ def poincare(params: ParamsBase, *, record: int | None = None, transient: int, x
         },
         coords={
             "n": ("n", np.arange(record), {"long_name": "section index"}),
-            "t_section": ("n", (used + 1 + np.arange(record)) * T,
+            "t_section": ("n", ts + (used + 1 + np.arange(record)) * T,
                           {"long_name": "section time", "units": "s"}),
-            "orbit_t": ("sample", (used + record) * T + np.arange(ns + 1) * (T / orbit_samples),
+            "orbit_t": ("sample", ts + (used + record) * T
+                        + np.arange(ns + 1) * (T / orbit_samples),
                         {"long_name": "phase-portrait time", "units": "s"}),
         },
         attrs=provenance_attrs(params, solver, analysis="poincare", record=record,

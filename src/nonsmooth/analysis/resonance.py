@@ -167,7 +167,8 @@ def resonance_curve(params: ParamsBase, omegas, *, method: str = "smooth", trans
                     atol: float = 1e-10, settle: bool = True,
                     resolution: float = 1e-4, branch_tol: float = 1e-3,
                     workers: int | None = None, progress=None,
-                    branches: str = "stable", store=None, engine=None) -> xr.Dataset:
+                    branches: str = "stable", store=None, engine=None,
+                    section_phase: float = 0.0) -> xr.Dataset:
     """Resonance curve over the forcing frequencies ``omegas`` (sorted ascending), swept up and
     down with continuation (see :func:`.bifurcation.bifurcation_diagram` for transient, record,
     settle). Returns a Dataset over (sweep, omega) with ``max_X``, ``min_X``, ``period``,
@@ -213,7 +214,7 @@ def resonance_curve(params: ParamsBase, omegas, *, method: str = "smooth", trans
     if branches not in ("stable", "all"):
         raise ParameterError(f"branches: expected 'stable' or 'all', got {branches!r}")
     solver = Solver(method=method, rtol=rtol, atol=atol,
-                    model=params.model)
+                    model=params.model, section_phase=section_phase)
     out = run_branches(params, w_name, omegas, solver, directions=["up", "down"],
                        transient=transient, record=record, x0=x0, v0=v0, settle=settle,
                        workers=workers, progress=progress, store=store, engine=engine,

@@ -87,7 +87,7 @@ def _checkpoints(periods: int, n_max: int = 500) -> np.ndarray:
 
 def lyapunov(params, *, periods: int = 10000, transient: int = 1000, x0: float = 0.0,
              v0: float = 0.0, method: str = "smooth", rtol: float = 1e-8, atol: float = 1e-10,
-             blocks: int = 20, progress=None) -> xr.Dataset:
+             blocks: int = 20, progress=None, section_phase: float = 0.0) -> xr.Dataset:
     """Lyapunov spectrum of the trajectory from (x0, v0), any model.
 
     The trajectory first runs ``transient`` forcing periods (the last ``ALIGN`` of them with
@@ -109,7 +109,8 @@ def lyapunov(params, *, periods: int = 10000, transient: int = 1000, x0: float =
     """
     from ..sweep import progress_callback
     progress = progress_callback(progress, "lyapunov")
-    params, solver, p, opts, state = start_trajectory(params, x0, v0, method, rtol, atol)
+    params, solver, p, opts, state = start_trajectory(params, x0, v0, method, rtol, atol,
+                                                      section_phase)
     periods = check_int("periods", periods, 1)
     transient = check_int("transient", transient, 0)
     blocks = check_int("blocks", blocks, 2)
@@ -209,7 +210,7 @@ def _section_state(setup, p, z, template):
 def periodic_orbit(params, *, k: int = 1, x0: float = 0.0, v0: float = 0.0,
                    method: str = "exact", transient: int = 0, tol: float = 1e-10,
                    max_iter: int = 40, rtol: float = 1e-10, atol: float = 1e-12,
-                   samples_per_period: int = 200) -> xr.Dataset:
+                   samples_per_period: int = 200, section_phase: float = 0.0) -> xr.Dataset:
     """A k-periodic orbit (fixed point of the k-fold stroboscopic map), stable or unstable, by
     Newton shooting from (x0, v0) (after ``transient`` periods).
 
@@ -228,7 +229,8 @@ def periodic_orbit(params, *, k: int = 1, x0: float = 0.0, v0: float = 0.0,
     sampled ``samples_per_period`` times a period (so with other steps than Newton's), and is
     reported converged only if it closes on itself to ``CONFIRM_TOL`` (1 + |z|).
     Bad input raises one-line ParameterErrors; a failed search is a status, not an error."""
-    params, solver, p, opts, state = start_trajectory(params, x0, v0, method, rtol, atol)
+    params, solver, p, opts, state = start_trajectory(params, x0, v0, method, rtol, atol,
+                                                      section_phase)
     k = check_int("k", k, 1)
     transient = check_int("transient", transient, 0)
     max_iter = check_int("max_iter", max_iter, 1)

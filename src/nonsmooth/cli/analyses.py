@@ -9,7 +9,7 @@ import typer
 
 from ..errors import ParameterError
 from .app import app
-from .common import (DEFAULT_MODEL, AtolOpt, DaskOpt, MethodOpt, ModelOpt, OutOpt, PlotOpt, PresetOpt, RtolOpt, SetOpt,
+from .common import (DEFAULT_MODEL, SectionPhaseOpt, AtolOpt, DaskOpt, MethodOpt, ModelOpt, OutOpt, PlotOpt, PresetOpt, RtolOpt, SetOpt,
                      WorkersOpt, check_outputs, chunk_store, echo_written, load_params,
                      preset_label, require_output, resolve_method, save_outputs)
 
@@ -83,6 +83,7 @@ def poincare_cmd(
     method: MethodOpt = None,
     rtol: RtolOpt = 1e-8,
     atol: AtolOpt = 1e-10,
+    section_phase: SectionPhaseOpt = 0.0,
     orbit_samples: Annotated[int, typer.Option(help="phase-portrait samples per period")] = 200,
     out: OutOpt = None,
     plot: PlotOpt = None,
@@ -103,7 +104,7 @@ def poincare_cmd(
     check_outputs(out, plot)
     with _progress("poincare") as prog:
         ds = poincare(params, record=record, transient=transient, x0=x0, v0=v0, method=method,
-                      rtol=rtol, atol=atol, orbit_samples=orbit_samples,
+                      rtol=rtol, atol=atol, section_phase=section_phase, orbit_samples=orbit_samples,
                       progress=prog)
     from ..plot.poincare import plot_poincare
     save_outputs(ds, preset, out, plot, plot_poincare)
@@ -131,6 +132,7 @@ def bifurcation_cmd(
     method: MethodOpt = None,
     rtol: RtolOpt = 1e-8,
     atol: AtolOpt = 1e-10,
+    section_phase: SectionPhaseOpt = 0.0,
     settle: SettleOpt = True,
     workers: WorkersOpt = None,
     dask: DaskOpt = None,
@@ -159,7 +161,7 @@ def bifurcation_cmd(
     with _progress(f"bifurcation {param} ({sweep})") as prog:
         ds = bifurcation_diagram(params, param, values, sweep=sweep, transient=transient,
                                  record=record, method=method, x0=x0, v0=v0, rtol=rtol,
-                                 atol=atol, settle=settle,
+                                 atol=atol, section_phase=section_phase, settle=settle,
                                  workers=workers, progress=prog, store=store, engine=engine)
     from ..plot.bifurcation import plot_bifurcation
     save_outputs(ds, preset, out, plot, plot_bifurcation, store=store)
@@ -183,6 +185,7 @@ def resonance_cmd(
     method: MethodOpt = None,
     rtol: RtolOpt = 1e-8,
     atol: AtolOpt = 1e-10,
+    section_phase: SectionPhaseOpt = 0.0,
     settle: SettleOpt = True,
     resolution: Annotated[float, typer.Option(help="bisection resolution of omega_a/b/c")] = 1e-4,
     all_branches: Annotated[bool, typer.Option(
@@ -212,7 +215,7 @@ def resonance_cmd(
     store, engine = chunk_store(out, dask)
     with _progress("resonance (up and down)") as prog:
         ds = resonance_curve(params, omegas, method=method, transient=transient, record=record,
-                             x0=x0, v0=v0, rtol=rtol, atol=atol,
+                             x0=x0, v0=v0, rtol=rtol, atol=atol, section_phase=section_phase,
                              settle=settle, resolution=resolution, workers=workers,
                              progress=prog, branches="all" if all_branches else "stable",
                              store=store, engine=engine)

@@ -8,7 +8,7 @@ from typing import Annotated, Optional
 import typer
 
 from .app import app
-from .common import (DEFAULT_MODEL, AtolOpt, DaskOpt, MethodOpt, ModelOpt, OutOpt, PlotOpt, PresetOpt, RtolOpt, SetOpt,
+from .common import (DEFAULT_MODEL, SectionPhaseOpt, AtolOpt, DaskOpt, MethodOpt, ModelOpt, OutOpt, PlotOpt, PresetOpt, RtolOpt, SetOpt,
                      WorkersOpt, check_outputs, chunk_store, echo_written, load_params,
                      preset_label, require_output, resolve_method, save_outputs)
 
@@ -28,6 +28,7 @@ def basins_cmd(
     method: MethodOpt = None,
     rtol: RtolOpt = 1e-8,
     atol: AtolOpt = 1e-10,
+    section_phase: SectionPhaseOpt = 0.0,
     workers: WorkersOpt = None,
     dask: DaskOpt = None,
     out: OutOpt = None,
@@ -51,7 +52,7 @@ def basins_cmd(
     with Progress("basins") as bar, warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always", UserWarning)
         ds = basins(params, x=x, v=v, grid=grid, method=method, transient=transient,
-                    max_periods=max_periods, max_period=max_period, rtol=rtol, atol=atol,
+                    max_periods=max_periods, max_period=max_period, rtol=rtol, atol=atol, section_phase=section_phase,
                     early_stop=not no_early_stop, workers=workers,
                     progress=bar, store=store, engine=engine)
     from ..plot.basins import plot_basins

@@ -35,6 +35,10 @@ MethodOpt = Annotated[Optional[str], typer.Option(
          "the model's first method if it has no smooth one")]
 RtolOpt = Annotated[float, typer.Option("--rtol", help="relative tolerance")]
 AtolOpt = Annotated[float, typer.Option("--atol", help="absolute tolerance")]
+SectionPhaseOpt = Annotated[float, typer.Option(
+    "--section-phase", help="forcing phase (radians, 0 <= phase < 2 pi) of the stroboscopic "
+                            "section t = t_s + kT: the trajectory starts there (move it off "
+                            "events that fall on t = kT, e.g. to continue through a fold)")]
 WorkersOpt = Annotated[Optional[int], typer.Option("--workers", "-j", help="threads (default: all cores)")]
 DaskOpt = Annotated[Optional[str], typer.Option(
     "--dask", show_default=False,

@@ -11,7 +11,7 @@ import typer
 from ..errors import ParameterError
 from .analyses import V0Opt, X0Opt
 from .app import app
-from .common import (DEFAULT_MODEL, AtolOpt, ModelOpt, OutOpt, PlotOpt, PresetOpt, RtolOpt, SetOpt,
+from .common import (DEFAULT_MODEL, SectionPhaseOpt, AtolOpt, ModelOpt, OutOpt, PlotOpt, PresetOpt, RtolOpt, SetOpt,
                      check_outputs, echo_written, load_params, preset_label, resolve_method,
                      save_outputs)
 from .stability import OrbitMethodOpt, _num, print_table
@@ -69,6 +69,7 @@ def continue_cmd(
     method: OrbitMethodOpt = None,
     rtol: RtolOpt = 1e-10,
     atol: AtolOpt = 1e-12,
+    section_phase: SectionPhaseOpt = 0.0,
     two_param: Annotated[Optional[str], typer.Option(
         "--two-param", show_default=False,
         help="a second parameter: follow the --special points of the branch as it changes "
@@ -112,11 +113,12 @@ def continue_cmd(
                              f"{param} = {lam0:g} (set it with --set {param}=VALUE)")
     if two_param is not None:
         return _two_parameter(params, preset, param, two_param, values, special, k, x0, v0,
-                              step, bounds, max_points, method, tol, out, plot)
+                              step, bounds, max_points, method, tol, out, plot, section_phase)
     check_outputs(out, plot)
     ds = continuation(params, param, k=k, x0=x0, v0=v0, transient=transient,
                       direction=direction, step=step, max_step=max_step, bounds=bounds,
-                      max_points=max_points, method=method, tol=tol, rtol=rtol, atol=atol)
+                      max_points=max_points, method=method, tol=tol, rtol=rtol, atol=atol,
+                      section_phase=section_phase)
     from ..plot.continuation import plot_continuation
     save_outputs(ds, preset, out, plot, plot_continuation)
     lam = ds[param].values
@@ -142,7 +144,7 @@ def continue_cmd(
 
 
 def _two_parameter(params, preset, param, param2, values, special, k, x0, v0, step, bounds,
-                   max_points, method, tol, out, plot):
+                   max_points, method, tol, out, plot, section_phase=0.0):
     """``nonsmooth continue --two-param``: the curve of --special points in (param, param2)."""
     import numpy as np
 
@@ -157,7 +159,7 @@ def _two_parameter(params, preset, param, param2, values, special, k, x0, v0, st
     check_outputs(out, plot)
     ds = two_parameter_curve(params, param, param2, grid, special=special, k=k, x0=x0, v0=v0,
                              bounds=bounds, step=step, max_points=max_points, method=method,
-                             tol=tol)
+                             tol=tol, section_phase=section_phase)
     save_outputs(ds, preset, out, plot, plot_two_parameter)
     found = int(np.isfinite(ds[param].values).any(axis=1).sum())
     typer.echo(f"{preset} ({method}): {special} points in ({param}, {param2}) at {found} of "

@@ -7,7 +7,7 @@ from typing import Annotated, Optional
 import typer
 
 from .app import app
-from .common import (DEFAULT_MODEL, AtolOpt, MethodOpt, ModelOpt, OutOpt, PlotOpt, PresetOpt, RtolOpt, SetOpt,
+from .common import (DEFAULT_MODEL, SectionPhaseOpt, AtolOpt, MethodOpt, ModelOpt, OutOpt, PlotOpt, PresetOpt, RtolOpt, SetOpt,
                      check_outputs, echo_written, load_params, preset_label,
                      require_output, resolve_method, save_outputs)
 
@@ -27,6 +27,7 @@ def simulate_cmd(
     method: MethodOpt = None,
     rtol: RtolOpt = 1e-8,
     atol: AtolOpt = 1e-10,
+    section_phase: SectionPhaseOpt = 0.0,
     out: OutOpt = None,
     plot: PlotOpt = None,
 ):
@@ -43,7 +44,7 @@ def simulate_cmd(
     spp = {} if samples_per_period is None else {"samples_per_period": samples_per_period}
     with _progress("simulate") as prog:
         ds = simulate(params, periods=periods, transient=transient, x0=x0, v0=v0, method=method,
-                      rtol=rtol, atol=atol, progress=prog, **spp)
+                      rtol=rtol, atol=atol, section_phase=section_phase, progress=prog, **spp)
     from ..plot.time_response import plot_time_response
     save_outputs(ds, preset, out, plot, plot_time_response)
     typer.echo(f"{preset}: {periods} periods after {transient}, max X = {float(ds.max_X):.6g}, "

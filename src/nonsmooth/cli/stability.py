@@ -10,7 +10,7 @@ import typer
 
 from .analyses import TransientOpt, V0Opt, X0Opt, _progress
 from .app import app
-from .common import (DEFAULT_MODEL, AtolOpt, MethodOpt, ModelOpt, OutOpt, PlotOpt, PresetOpt, RtolOpt, SetOpt,
+from .common import (DEFAULT_MODEL, SectionPhaseOpt, AtolOpt, MethodOpt, ModelOpt, OutOpt, PlotOpt, PresetOpt, RtolOpt, SetOpt,
                      check_outputs, echo_written, load_params, preset_label, resolve_method,
                      save_outputs)
 
@@ -67,6 +67,7 @@ def lyapunov_cmd(
     method: MethodOpt = None,
     rtol: RtolOpt = 1e-8,
     atol: AtolOpt = 1e-10,
+    section_phase: SectionPhaseOpt = 0.0,
     out: OutOpt = None,
     plot: PlotOpt = None,
 ):
@@ -85,7 +86,7 @@ def lyapunov_cmd(
     check_outputs(out, plot)
     with _progress("lyapunov") as prog:
         ds = lyapunov(params, periods=periods, transient=transient, x0=x0, v0=v0,
-                      method=method, rtol=rtol, atol=atol, blocks=blocks, progress=prog)
+                      method=method, rtol=rtol, atol=atol, section_phase=section_phase, blocks=blocks, progress=prog)
     from ..plot.stability import plot_lyapunov
     save_outputs(ds, preset, out, plot, plot_lyapunov)
     T = float(ds.attrs["forcing_period"])
@@ -117,6 +118,7 @@ def orbit_cmd(
     method: OrbitMethodOpt = None,
     rtol: RtolOpt = 1e-10,
     atol: AtolOpt = 1e-12,
+    section_phase: SectionPhaseOpt = 0.0,
     out: OutOpt = None,
     plot: PlotOpt = None,
 ):
@@ -136,7 +138,8 @@ def orbit_cmd(
     check_int("max_iter", max_iter, 1)
     check_outputs(out, plot)
     ds = periodic_orbit(params, k=k, x0=x0, v0=v0, method=method, transient=transient,
-                        tol=tol, max_iter=max_iter, rtol=rtol, atol=atol)
+                        tol=tol, max_iter=max_iter, rtol=rtol, atol=atol,
+                      section_phase=section_phase)
     a = ds.attrs
     if a["status"] != "converged":
         typer.echo(f"error: orbit: no period-{k} orbit found from (x0, v0) = ({x0:g}, {v0:g}): "

@@ -30,7 +30,8 @@ OPT_OMEGA = 4  # index of the forcing frequency omega in p (generic kernel)
 OPT_N = 5  # state dimension n >= 2 (generic kernel)
 OPT_NMEM = 6  # number of discrete memory slots (generic kernel)
 OPT_CLOSED_FORM = 7  # 1: propagate the modes a model declares linear in closed form (generic)
-N_OPTS = 8
+OPT_PHASE = 8  # forcing phase psi = omega t_s of the section (generic): periods start at t_s
+N_OPTS = 9
 
 # state layout
 ST_X = 0

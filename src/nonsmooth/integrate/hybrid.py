@@ -34,8 +34,10 @@ Design summary
 * Work arrays are views into one workspace without reference counting (:mod:`.workspace`):
   numba would otherwise increment and decrement a reference count atomically for every array
   passed to a model function, which took most of the time of a step.
-* The local time restarts at 0 at each forcing period and the step state (u, mode, h, mem) is
-  all that carries over, so results are split-invariant bit for bit.
+* The local time restarts at each forcing period and the step state (u, mode, h, mem) is
+  all that carries over, so results are split-invariant bit for bit. It restarts at
+  t0 = psi / omega, psi = ``opts[OPT_PHASE]`` the forcing phase of the section (0 by default):
+  a period runs from t0 to t0 + T, the functions receive that t and (cos, sin)(omega t).
 
 Status codes: OK, MAX_STEPS, STEP_TOO_SMALL, NON_FINITE (also for a non-finite input, a
 non-positive omega, or an opts layout that does not fit ``state``), ZENO, EVENT_FAILED (a
@@ -65,6 +67,7 @@ from .contract import (  # noqa: E402
     OPT_MAX_STEPS,
     OPT_N,
     OPT_NMEM,
+    OPT_PHASE,
     OPT_OMEGA,
     OPT_RTOL,
     ST_EXTRA,
@@ -787,9 +790,15 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
     n_total = n_skip + n_out
     max_steps = int(opts[OPT_MAX_STEPS] * (n_total / per_period + 1.0))
 
+    # the section's forcing phase: every period starts at t0 = psi / omega (0: the default,
+    # bit for bit the arithmetic without a phase)
+    psi = opts[OPT_PHASE]
+    t0 = psi / om
+    C0 = math.cos(psi) if psi != 0.0 else 1.0
+    S0 = math.sin(psi) if psi != 0.0 else 0.0
     code = st.OK
     if mode < 0:
-        mode = initial(1.0, 0.0, u, pp, mem)
+        mode = initial(C0, S0, u, pp, mem)
     if mode < 0 or mode >= MAX_MODES:
         _store(state, u, n, mem, nmem, mode, h)
         keep_alive(ws)
@@ -804,9 +813,9 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
     if cf:
         _cf_bounds(MC, mode, om, G, ng, n, GB)
 
-    tau = 0.0
-    C = 1.0
-    S = 0.0
+    tau = t0
+    C = C0
+    S = S0
     _deriv(cf, field, mode, tau, C, S, u, pp, mem, f0, MC, om)
     steps = 0
     rejected = False
@@ -815,7 +824,7 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
     j = 0
     for it in range(n_total):
         j += 1
-        t_end = T if j == per_period else j * dt
+        t_end = t0 + (T if j == per_period else j * dt)
         xmax = u[0]
         xmin = u[0]
         mask = 1 << mode
@@ -1057,10 +1066,10 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
             break
         if j == per_period:
             j = 0
-            tau = 0.0
+            tau = t0
             t_switch -= T
-            C = 1.0
-            S = 0.0
+            C = C0
+            S = S0
             rejected = False
             _deriv(cf, field, mode, tau, C, S, u, pp, mem, f0, MC, om)
             if tan and qr == 1:

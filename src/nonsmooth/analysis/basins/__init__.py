@@ -145,7 +145,7 @@ def basins(params: ParamsBase, *, x=(-3.0, 3.0), v=(-3.0, 3.0), grid=400, method
            atol: float = 1e-10, early_stop: bool = True,
            samples_per_period: int = 200, workers: int | None = None,
            progress=None, lyapunov: bool | None = None, store=None,
-           engine=None) -> xr.Dataset:
+           engine=None, section_phase: float = 0.0) -> xr.Dataset:
     """Basins of attraction of the stroboscopic map on a grid of initial conditions.
 
     ``x``, ``v``: (min, max) ranges of the initial X and V (forcing phase 0); ``grid``: points
@@ -194,7 +194,7 @@ def basins(params: ParamsBase, *, x=(-3.0, 3.0), v=(-3.0, 3.0), grid=400, method
     max_period = check_int("max_period", max_period, 1)
     spp = check_int("samples_per_period", samples_per_period, 2)
     solver = Solver(method=method, rtol=rtol, atol=atol,
-                    model=params.model)
+                    model=params.model, section_phase=section_phase)
     nw = resolve_workers(workers)
     n = nx * nv
     check_memory(n * _BYTES_PER_POINT, "grid",
