@@ -107,40 +107,6 @@ def test_regularised_law_with_logistic_and_softplus_matches_the_example_and_its_
                                np.sort(ob.multiplier_abs.values), rtol=1e-6)
 
 
-def test_bouncing_ball_period_one_orbit_and_its_period_doubling_against_closed_forms():
-    """A ball on a table y = A sin(omega t), in the relative coordinate Z = x - y: free flight
-    Z'' = -g + A omega^2 sin(omega t), Z' -> -r Z' at Z = 0 (no closed form: k = 0, so the exact
-    method runs RKF45 at rtol 1e-12). Period-one orbit (g = T = 1, Gamma = A omega^2 / g): the
-    ball leaves with absolute velocity T/2 at the phase phi, Gamma cos(phi) = pi (1 - r)/(1 + r);
-    the impact map's Jacobian has trace 1 + r^2 - (1 + r)^2 Gamma sin(phi) and determinant r^2,
-    so the orbit doubles its period at Gamma^2 = (pi (1-r)/(1+r))^2 + (2 (1+r^2)/(1+r)^2)^2."""
-    ball = ns.model_from_equations(
-        "bouncing_ball", states=("Z", "V"),
-        parameters={"g": 1.0, "A": 0.03, "omega": 2 * math.pi,
-                    "r": dict(default=0.5, low=0.0, high=1.0)},
-        modes={"flight": ["V", "-g + A*omega**2*sin(omega*t)"]},
-        guards={"flight": [ns.Guard("Z", "flight", reset={"V": "-r*V"})]}, method="exact")
-    assert ball.methods["exact"].rtol == 1e-12  # no closed form: a tight RKF45
-    w, r = 2 * math.pi, 0.5
-    g1 = math.pi * (1 - r) / (1 + r)
-    g_pd = math.hypot(g1, 2 * (1 + r * r) / (1 + r) ** 2)
-    for gamma, crossed in ((1.2, False), (g_pd - 1e-3, False), (g_pd + 1e-3, True)):
-        A = gamma / w**2
-        phi = math.acos(g1 / gamma)
-        s = 1.0 - phi / w  # flight time from the impact to the section t = T
-        z0, v0 = 0.5 * s - 0.5 * s * s + A * math.sin(phi), 0.5 - s - A * w
-        p = ball.params(A=A, r=r)
-        ds = ns.simulate(p, periods=2, x0=z0, v0=v0, method="exact", samples_per_period=1)
-        assert np.max(np.abs(ds.X.values - z0)) < 1e-9  # the closed-form orbit is periodic
-        orb = ns.periodic_orbit(p, x0=z0, v0=v0, transient=0, method="exact")
-        assert int(orb.converged) == 1 and abs(float(orb.X_section[0]) - z0) < 1e-9
-        mu = orb.multiplier_real.values + 1j * orb.multiplier_imag.values
-        trace = 1 + r * r - (1 + r) ** 2 * gamma * math.sin(phi)
-        assert mu.sum().real == pytest.approx(trace, abs=1e-7)
-        assert abs(np.prod(mu)) == pytest.approx(r * r, rel=1e-7)
-        assert (np.min(mu.real) < -1.0) == crossed
-
-
 def test_any_periodic_forcing_through_the_local_time():
     """Two harmonics and a constant load on a linear oscillator (no surfaces): the model reads
     cos(2 omega t) from the period's local time; scipy integrates the same equation."""

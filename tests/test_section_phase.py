@@ -1,7 +1,8 @@
 """Sections at any forcing phase (issue 23, item 4): ``section_phase`` psi starts every period
 at t_s = psi / omega. Oracles: the same trajectory sampled at t_s + kT by the phase-0 run (any
 model and method; the specialised support kernels run phase 0, the generic kernel the shifted
-run), the closed-form fold of the bouncing ball that continuation cannot pass at phase 0."""
+run; the closed-form fold of the bouncing ball that continuation passes only off phase 0 is in
+test_model_bouncing_ball.py)."""
 
 import math
 import subprocess
@@ -48,36 +49,6 @@ def test_poincare_at_a_phase_reports_its_section_times():
     zero = ns.poincare(p, record=20, transient=300, method="exact")
     assert int(ds.period) == int(zero.period) == 1  # the same attractor, another section
     assert abs(float(ds.X[0]) - float(zero.X[0])) > 1e-3
-
-
-def ball():
-    return ns.model_from_equations(
-        "ball_on_table", states=("Z", "V"),
-        parameters={"g": 1.0, "A": 0.03, "omega": 2 * math.pi,
-                    "r": dict(default=0.5, low=0.0, high=1.0)},
-        modes={"flight": ["V", "-g + A*omega**2*sin(omega*t)"]},
-        guards={"flight": [ns.Guard("Z", "flight", reset={"V": "-r*V"})]}, method="exact")
-
-
-def test_continuation_passes_the_bouncing_ball_fold_at_another_phase():
-    """At the fold Gamma = pi (1 - r)/(1 + r) of the period-one orbit the impact falls on t = kT:
-    at phase 0 continuation cannot pass it; with the section at phase pi it locates it."""
-    m, w, r = ball(), 2 * math.pi, 0.5
-    g1 = math.pi * (1 - r) / (1 + r)
-    gamma = 1.3
-    A, phi = gamma / w**2, math.acos(g1 / gamma)
-    found = {}
-    for psi in (0.0, math.pi):
-        s = (psi - phi) / w % 1.0  # flight time from the impact to the section
-        z0 = 0.5 * s - 0.5 * s * s + A * math.sin(phi) - A * math.sin(psi)
-        v0 = 0.5 - s - A * w * math.cos(psi)
-        br = ns.continuation(m.params(A=A, r=r), "A", x0=z0, v0=v0, direction="down",
-                             bounds=(0.5 * g1 / w**2, 1.45 / w**2), section_phase=psi)
-        found[psi] = (br.attrs["status"], br.special_type.values, br["special_A"].values * w**2)
-    assert "cannot continue" in found[0.0][0] and found[0.0][1].size == 0
-    status, types, gammas = found[math.pi]
-    assert list(types) == [1] and "bounds" in status  # one fold, then out of the bounds
-    assert gammas[0] == pytest.approx(g1, abs=1e-9)
 
 
 @pytest.mark.parametrize("bad", [-0.1, 2 * math.pi, math.nan, "x", True])

@@ -8,6 +8,7 @@ BUILTIN = {
     "two_sided": "nonsmooth.models.two_sided",
     "impact": "nonsmooth.models.impact",
     "stick_slip": "nonsmooth.models.stick_slip",
+    "bouncing_ball": "nonsmooth.models.bouncing_ball",
 }
 
 #: The model a command uses when none is named: the paper's.

@@ -49,6 +49,7 @@ signatures of :mod:`nonsmooth.integrate.contract`). It declares
   ``resonance_curve``; None where it has no meaning), ``lines(params, method)`` (values of X to draw, with labels;
   ``params`` may be None when a result's parameters cannot be read), display data for figures
   and the CLI (``mode_labels``: mathtext legend labels per mode, default ``mode_names``;
+  ``axis_labels``: mathtext axis labels of the state components, default ``state_names``;
   ``line_labels``: mathtext for the labels of ``lines``; ``mode_word``: what the modes are
   called, e.g. "regions") and, per
   method, ``flow_is_homeomorphism`` (false where trajectories merge, e.g. in sticking: basins
@@ -258,6 +259,7 @@ class Model:
     contact_level: Callable | None = None
     lines: Callable | None = None
     mode_labels: tuple = ()
+    axis_labels: tuple = ()
     line_labels: dict = _field(default_factory=dict)
     mode_word: str = "modes"
     contact_label: str = ""

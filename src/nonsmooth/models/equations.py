@@ -7,8 +7,9 @@ It derives what the model interface (:mod:`nonsmooth.models.base`) asks for by h
 * the Jacobian of every mode's field (SymPy differentiation, common subexpressions shared);
 * the guards as affine rows: a surface must be affine in the state and in cos(omega t),
   sin(omega t) (coefficients may depend on the parameters); its coefficients are read off
-  exactly. A surface that is not affine, or whose gradient in the state is zero, is refused
-  with one line naming it;
+  exactly. A surface that is not affine, or that depends on neither the state nor the
+  forcing phase, is refused with one line naming it (one of the phase alone is a timed exit,
+  e.g. a stuck mass released when the forcing turns);
 * the closed form of linear modes (two states X, V with X' = V and
   V' = -k X - c V + F cos(omega t) + b, k > 0, coefficients of the parameters only): the
   ``exact`` method then propagates them exactly, as the built-in models do;
@@ -76,8 +77,9 @@ class Guard:
     reset: dict | None = None
 
 
-def model_from_equations(name: str, *, states, parameters, modes: dict, guards: dict | None = None,
-                         initial=None, method: str = "exact", omega: str = "omega",
+def model_from_equations(name: str, *, states, parameters, modes: dict | None = None,
+                         guards: dict | None = None, initial=None, method: str = "exact",
+                         methods: dict | None = None, omega: str = "omega",
                          forcing_amplitude: str | None = None, description: str = "",
                          flow_is_homeomorphism: bool = False, closed_form: bool = True,
                          rtol: float | None = None, atol: float | None = None,
@@ -92,9 +94,13 @@ def model_from_equations(name: str, *, states, parameters, modes: dict, guards: 
     the tolerances the method enforces at most (default for an "exact" method with a mode
     that has no closed form: :data:`EXACT_RTOL`, :data:`EXACT_ATOL`). ``initial``:
     ``[(condition, mode), ...]`` classifying a state at t = 0 (default: the first mode whose
-    surfaces hold). ``method``: the name of the one method these equations define ("exact"
-    for a non-smooth system, "smooth" for a regularised one). ``omega``: the forcing frequency
-    parameter. ``contact_modes``: mode names that count as contact. Other keywords
+    surfaces hold). ``method``: the name of the method these equations define ("exact"
+    for a non-smooth system, "smooth" for a regularised one). Several methods:
+    ``methods={"exact": dict(modes=..., guards=..., initial=..., rtol=..., atol=...,
+    description=..., flow_is_homeomorphism=...), "smooth": dict(...)}`` instead of ``modes``,
+    ``guards``, ``initial`` and ``method``; the model's modes are those of all methods, in
+    order of appearance (a mode of the same name is one mode). ``omega``: the forcing
+    frequency parameter. ``contact_modes``: mode names that count as contact. Other keywords
     (``state_units``, ``state_long_names``, ``presets``, ``contact_name``, ``lines``,
     ``references``, ``check``, ...) go to :class:`Model` as they are.
 
@@ -104,6 +110,12 @@ def model_from_equations(name: str, *, states, parameters, modes: dict, guards: 
     import sympy as sp
 
     bad = lambda msg: ParameterError(f"model {name}: {msg}")  # noqa: E731
+    if methods is None:
+        methods = {method: dict(modes=modes, guards=guards, initial=initial, rtol=rtol,
+                                atol=atol, description=description,
+                                flow_is_homeomorphism=flow_is_homeomorphism)}
+    elif modes is not None or guards is not None or initial is not None:
+        raise bad("give either methods={...} or modes/guards/initial, not both")
     states = tuple(states)
     params = _parameters(parameters, bad)
     pnames = tuple(q.name for q in params)
@@ -114,55 +126,75 @@ def model_from_equations(name: str, *, states, parameters, modes: dict, guards: 
         raise bad("state and parameter names must all differ")
     if omega not in pnames:
         raise bad(f"the forcing frequency {omega!r} must be a parameter")
-    mode_names = tuple(modes)
+    mode_names = tuple(dict.fromkeys(m for spec in methods.values()
+                                     for m in (spec.get("modes") or {})))
     if not mode_names:
         raise bad("at least one mode is needed")
-    n = len(states)
     sym = {nm: sp.Symbol(nm, real=True) for nm in states + pnames}
     t = sp.Symbol("t", real=True)
     C, S = sp.Symbol("_C", real=True), sp.Symbol("_S", real=True)
     ctx = _Context(sp, sym, t, C, S, sym[omega], set(states), name)
-
-    fields = {}
-    for mname, exprs in modes.items():
-        exprs = list(exprs) if not isinstance(exprs, str) else [exprs]
-        if len(exprs) != n:
-            raise bad(f"mode {mname}: {len(exprs)} expressions for {n} states")
-        fields[mname] = [ctx.parse(e, f"mode {mname}, d{states[i]}/dt")
-                         for i, e in enumerate(exprs)]
-    rows, branches = {}, {}
-    for mname, glist in (guards or {}).items():
-        if mname not in mode_names:
-            raise bad(f"guards: unknown mode {mname!r} (modes: {', '.join(mode_names)})")
-        rows[mname], branches[mname] = [], []
-        for j, g in enumerate(glist):
-            g = g if isinstance(g, Guard) else Guard(*g)
-            where = f"mode {mname}, surface {j}"
-            rows[mname].append(ctx.affine_row(ctx.parse(g.surface, where), where))
-            branches[mname].append(ctx.branches(g, where, mode_names))
-    init = [(ctx.condition(cond, f"initial, condition {i}"), _mode_index(m, mode_names, bad))
-            for i, (cond, m) in enumerate(initial or ())]
-    linear = {m: ctx.linear(fields[m]) for m in mode_names} if closed_form and n == 2 else {}
-
-    source = _source(sp, ctx, states, pnames, mode_names, fields, rows, branches, init, linear)
-    module = _load(name, source)
+    built = {}
+    for mname, spec in methods.items():
+        unknown = set(spec) - {"modes", "guards", "initial", "rtol", "atol", "description",
+                               "flow_is_homeomorphism"}
+        if unknown:
+            raise bad(f"method {mname}: unknown key {sorted(unknown)[0]!r}")
+        built[mname] = _method(sp, ctx, name, mname, spec, states, pnames, mode_names,
+                               closed_form, bad)
     if isinstance(contact_modes, (tuple, list)):
         contact_modes = sum(1 << _mode_index(m, mode_names, bad) for m in contact_modes)
-    has_linear = any(v is not None for v in linear.values())
-    if method == "exact" and rtol is None and atol is None \
-            and not all(linear.get(m) is not None for m in mode_names):
-        rtol, atol = EXACT_RTOL, EXACT_ATOL  # nonlinear modes of an exact method: RKF45, tight
-    meth = Method(module.field, module.jacobian, module.guards, module.transition,
-                  module.initial, module.linear if has_linear else None,
-                  closed_form=has_linear, flow_is_homeomorphism=flow_is_homeomorphism,
-                  modes=tuple(range(len(mode_names))), rtol=rtol, atol=atol,
-                  description=description or f"written as equations ({len(mode_names)} modes)")
     model = Model(name=name, description=description or "a model written as equations",
                   parameters=params, state_names=states, mode_names=mode_names,
-                  methods={method: meth}, omega=omega, forcing_amplitude=forcing_amplitude,
+                  methods=built, omega=omega, forcing_amplitude=forcing_amplitude,
                   contact_modes=contact_modes, **model_kw)
-    model.fns(method)  # compile and sample-check now: a malformed model fails here
+    for mname in built:
+        model.fns(mname)  # compile and sample-check now: a malformed model fails here
     return model
+
+
+def _method(sp, ctx, name, mname, spec, states, pnames, mode_names, closed_form, bad) -> Method:
+    """One method's :class:`Method`: parse, derive, generate and load its functions."""
+    n = len(states)
+    own = tuple(spec.get("modes") or {})
+    if not own:
+        raise bad(f"method {mname}: at least one mode is needed")
+    fields = {}
+    for mode, exprs in spec["modes"].items():
+        exprs = list(exprs) if not isinstance(exprs, str) else [exprs]
+        if len(exprs) != n:
+            raise bad(f"mode {mode}: {len(exprs)} expressions for {n} states")
+        fields[mode] = [ctx.parse(e, f"mode {mode}, d{states[i]}/dt")
+                        for i, e in enumerate(exprs)]
+    rows, branches = {}, {}
+    for mode, glist in (spec.get("guards") or {}).items():
+        if mode not in own:
+            raise bad(f"guards: unknown mode {mode!r} (modes: {', '.join(own)})")
+        rows[mode], branches[mode] = [], []
+        for j, g in enumerate(glist):
+            g = g if isinstance(g, Guard) else Guard(*g)
+            where = f"mode {mode}, surface {j}"
+            rows[mode].append(ctx.affine_row(ctx.parse(g.surface, where), where))
+            branches[mode].append(ctx.branches(g, where, own, mode_names))
+    init = [(ctx.condition(cond, f"initial, condition {i}"), mode_names.index(m))
+            for i, (cond, m) in enumerate(spec.get("initial") or ())
+            if _mode_index(m, own, bad) >= 0]
+    linear = {m: ctx.linear(fields[m]) for m in own} if closed_form and n == 2 else {}
+    source = _source(sp, ctx, states, pnames, mode_names, own, fields, rows, branches, init,
+                     linear)
+    module = _load(f"{name}_{mname}", source)
+    has_linear = any(v is not None for v in linear.values())
+    rtol, atol = spec.get("rtol"), spec.get("atol")
+    if mname == "exact" and rtol is None and atol is None \
+            and not all(linear.get(m) is not None for m in own):
+        rtol, atol = EXACT_RTOL, EXACT_ATOL  # nonlinear modes of an exact method: RKF45, tight
+    return Method(module.field, module.jacobian, module.guards, module.transition,
+                  module.initial, module.linear if has_linear else None,
+                  closed_form=has_linear,
+                  flow_is_homeomorphism=bool(spec.get("flow_is_homeomorphism", False)),
+                  modes=tuple(mode_names.index(m) for m in own), rtol=rtol, atol=atol,
+                  description=spec.get("description")
+                  or f"written as equations ({len(own)} modes)")
 
 
 _STEPS: dict = {}
@@ -303,14 +335,16 @@ class _Context:
         if any(c.free_symbols & set(var) for c in coef):
             raise self.bad(f"{where}: the surface {g} is not affine in the state and "
                            f"cos/sin(omega t) (curved surfaces are not supported yet)")
-        if all(sp.simplify(c) == 0 for c in coef[:len(self.states)]):
-            raise self.bad(f"{where}: the surface {g} has a zero gradient in the state")
+        if all(sp.simplify(c) == 0 for c in coef):  # (a surface of time alone is allowed)
+            raise self.bad(f"{where}: the surface {g} has a zero gradient (it depends on "
+                           f"neither the state nor cos/sin(omega t))")
         const = g.subs({v: 0 for v in var})
         n = len(self.states)
         return coef[:n] + [const, coef[n], coef[n + 1]]
 
-    def branches(self, g, where, mode_names):
-        """[(condition, mode index, {state index: expression}), ...] of a guard."""
+    def branches(self, g, where, own, mode_names):
+        """[(condition, mode index, {state index: expression}), ...] of a guard (targets among
+        the method's modes ``own``, indices among the model's ``mode_names``)."""
         to = g.to
         if isinstance(to, str):
             to = [("True", to, g.reset)]
@@ -321,8 +355,8 @@ class _Context:
                                f"reset), got {br!r}")
             cond, mode = br[0], br[1]
             reset = br[2] if len(br) == 3 and br[2] is not None else g.reset or {}
-            if mode not in mode_names:
-                raise self.bad(f"{where}: unknown mode {mode!r} (modes: {', '.join(mode_names)})")
+            if mode not in own:
+                raise self.bad(f"{where}: unknown mode {mode!r} (modes: {', '.join(own)})")
             cond = self.sp.true if cond in (True, "True") else self.condition(
                 cond, f"{where}, condition {i}")
             names = [s.name for s in self.states]
@@ -352,7 +386,8 @@ class _Context:
         return -coef[0], -coef[1], b, coef[2]
 
 
-def _source(sp, ctx, states, pnames, mode_names, fields, rows, branches, init, linear) -> str:
+def _source(sp, ctx, states, pnames, mode_names, own, fields, rows, branches, init,
+            linear) -> str:
     """The Python source of the six model functions."""
     from sympy.printing.pycode import PythonCodePrinter
 
@@ -388,7 +423,7 @@ def _source(sp, ctx, states, pnames, mode_names, fields, rows, branches, init, l
     def by_mode(body_of, indent="    ", default="return 0"):
         out = []
         for m, mname in enumerate(mode_names):
-            body = body_of(mname)
+            body = body_of(mname) if mname in own else []
             if body:
                 out.append(f"{indent}{'if' if not out else 'elif'} mode == {m}:")
                 out += [f"{indent}    {ln}" for ln in body]
@@ -437,13 +472,15 @@ def _source(sp, ctx, states, pnames, mode_names, fields, rows, branches, init, l
     src += ["", "", "def initial(c, s, u, p, mem):", "    t = 0.0", *unpack_u, *unpack_p]
     src += [f"    if {code(cond)}:\n        return {m}" for cond, m in init]
     for m, mname in enumerate(mode_names):
+        if mname not in own:
+            continue
         tests = []
         for row in rows.get(mname, ()):
             g = sum((row[i] * X[i] for i in range(n)), sp.Integer(0)) + row[n] \
                 + row[n + 1] * ctx.C + row[n + 2] * ctx.S
             tests.append(f"({code(g)}) >= 0.0")
         src.append(f"    if {' and '.join(tests) or 'True'}:\n        return {m}")
-    src += ["    return 0"]
+    src += [f"    return {mode_names.index(own[0])}"]
 
     def linear_body(m):
         lin = linear.get(m)

@@ -10,7 +10,8 @@ from matplotlib.colors import BoundaryNorm, ListedColormap
 from matplotlib.lines import Line2D
 from matplotlib.patches import Patch
 
-from .common import draw_model_lines, model_of, new_figure, param_symbol, param_title
+from .common import (draw_model_lines, model_of, new_figure, param_symbol, param_title,
+                     state_labels)
 
 #: Basin colours: light for attractors without contact, dark for those with contact (as in the
 #: paper's Fig. 7), cycling through hues when there are several of a kind.
@@ -127,8 +128,8 @@ def plot_attractors(ds, ax=None):
                    facecolor=colors[k],
                    edgecolor="k", lw=1.0, zorder=3)
     draw_model_lines(ax, ds, "v", band_edges=False, style=dict(lw=0.8))
-    ax.set_xlabel("X = x/g")
-    ax.set_ylabel(r"V = $\dot X$")
+    ax.set_xlabel(state_labels(ds)[0])
+    ax.set_ylabel(state_labels(ds)[1])
     if ax.get_legend_handles_labels()[0]:
         ax.legend(loc="best", fontsize=8)
     title = "coexisting attractors" + _omega_text(ds)

@@ -63,6 +63,15 @@ def mode_labels(m, n=None) -> tuple:
     return tuple(m.mode_labels or m.mode_names)
 
 
+def state_labels(ds) -> tuple:
+    """Axis labels (mathtext) of the state components of the dataset's model: its
+    ``axis_labels``, else its ``state_names``; (X, V) when the model cannot be loaded."""
+    m = model_of(ds)
+    if m is None:
+        return ("$X$", "$V$")
+    return tuple(m.axis_labels) or tuple(f"${n}$" for n in m.state_names)
+
+
 def param_symbol(m, name: str) -> str:
     """The plot symbol (mathtext) of parameter ``name`` of model ``m`` (the name if none)."""
     if m is not None:

@@ -3,7 +3,8 @@
 from __future__ import annotations
 
 
-from .common import draw_model_lines, model_of, new_figure, param_title, scatter_by_region
+from .common import (draw_model_lines, model_of, new_figure, param_title, scatter_by_region,
+                     state_labels)
 
 
 def _period_text(ds) -> str:
@@ -28,8 +29,8 @@ def plot_poincare(ds):
                 marker="o", zorder=3, linewidths=0,
                 label=r"section $t = kT$")
     draw_model_lines(ax0, ds, "v", label=False, band_edges=False)
-    ax0.set_xlabel(r"$X = x/g$")
-    ax0.set_ylabel(r"$V = \dot X$")
+    ax0.set_xlabel(state_labels(ds)[0])
+    ax0.set_ylabel(state_labels(ds)[1])
     ax0.set_title(f"(a) phase portrait: {_period_text(ds)}", fontsize=10)
     ax0.legend(loc="lower left", fontsize=7, markerscale=2)
     n = X.size

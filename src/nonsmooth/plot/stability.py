@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .common import (MODE_COLORS, draw_model_lines, model_of, new_figure, param_title,
+from .common import (MODE_COLORS, draw_model_lines, model_of, new_figure, param_title, state_labels,
                      scatter_by_region)
 
 
@@ -79,8 +79,8 @@ def plot_orbit(ds, ax=None):
     ax.scatter(ds["X_section"].values, ds["V_section"].values, s=60, facecolor="w",
                edgecolor="k", lw=1.5, zorder=3, label=r"section $t = jT$")
     draw_model_lines(ax, ds, "v", band_edges=False)
-    ax.set_xlabel(r"$X = x/g$")
-    ax.set_ylabel(r"$V = \dot X$")
+    ax.set_xlabel(state_labels(ds)[0])
+    ax.set_ylabel(state_labels(ds)[1])
     ax.grid(True, lw=0.3, alpha=0.5)
     ax.legend(loc="lower left", fontsize=7, markerscale=1.5)
     found = a.get("status", "") == "converged"

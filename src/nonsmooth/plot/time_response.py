@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .common import (draw_model_lines, draw_phase_lines, has_support_bands, mode_colors,
+from .common import (draw_model_lines, draw_phase_lines, has_support_bands, mode_colors, state_labels,
                      mode_labels, model_lines, model_of, new_figure, param_title,
                      scatter_by_region)
 
@@ -42,7 +42,7 @@ def plot_time_response(ds):
     _crossed_between_samples(ax, t, X, R, M, model)
     draw_model_lines(ax, ds, "h", label=False, band_edges=False)
     ax.set_xlabel("t [s]")
-    ax.set_ylabel("X = x/g")
+    ax.set_ylabel(state_labels(ds)[0])
     ax.set_title("time response")
     ax.legend(loc="upper right", markerscale=3, fontsize=8)
     for ax, zoom in ((axes[1], False), (axes[2], True)):

@@ -74,6 +74,7 @@ MODEL = Model(
     contact_level=lambda params: 1.0,
     mode_labels=(r"$\Gamma_-$", r"$\Sigma_\alpha$", r"$\Sigma_\beta$", r"$\Gamma_+$"),
     line_labels={"support (X = 1)": r"support $X = 1$"},
+    axis_labels=(r"$X = x/g$", r"$V = \dot X$"),
     mode_word="regions",
     contact_label="Gamma+",
     presets=PRESETS,

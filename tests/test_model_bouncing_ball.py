@@ -1,0 +1,77 @@
+"""The built-in ``bouncing_ball`` (written as equations) against its closed forms: the
+period-one orbit, its Floquet multipliers, its period doubling and its fold (located by
+continuation with the section moved off the impact), the smooth method converging to the exact
+one, chatter ending in sticking."""
+
+import math
+
+import numpy as np
+import pytest
+
+import nonsmooth as ns
+
+pytestmark = pytest.mark.filterwarnings("ignore::numba.NumbaExperimentalFeatureWarning")
+
+M = ns.model("bouncing_ball")
+W, R = 2 * math.pi, 0.5  # omega = 2 pi, g = 1: T = 1
+G1 = math.pi * (1 - R) / (1 + R)  # the fold: Gamma cos(phi) = pi (1 - r)/(1 + r)
+G_PD = math.hypot(G1, 2 * (1 + R * R) / (1 + R) ** 2)
+
+
+def on_orbit(gamma, psi=0.0):
+    """Parameters and the period-one orbit's state at the section of phase psi: the ball left
+    the table at the phase phi with absolute velocity g T / 2 = 1/2."""
+    A, phi = gamma / W**2, math.acos(G1 / gamma)
+    s = (psi - phi) / W % 1.0  # flight time from the impact to the section
+    z0 = 0.5 * s - 0.5 * s * s + A * math.sin(phi) - A * math.sin(psi)
+    return M.params(A=A, r=R), z0, 0.5 - s - A * W * math.cos(psi)
+
+
+def test_period_one_orbit_its_multipliers_and_its_period_doubling():
+    assert M.methods["exact"].rtol == 1e-12  # free flight has no closed form: a tight RKF45
+    for gamma, crossed in ((1.2, False), (G_PD - 1e-3, False), (G_PD + 1e-3, True)):
+        p, z0, v0 = on_orbit(gamma)
+        ds = ns.simulate(p, periods=2, x0=z0, v0=v0, method="exact", samples_per_period=1)
+        assert np.max(np.abs(ds.X.values - z0)) < 1e-9  # the closed-form orbit is periodic
+        orb = ns.periodic_orbit(p, x0=z0, v0=v0, transient=0, method="exact")
+        assert int(orb.converged) == 1 and abs(float(orb.X_section[0]) - z0) < 1e-9
+        mu = orb.multiplier_real.values + 1j * orb.multiplier_imag.values
+        trace = 1 + R * R - (1 + R) ** 2 * gamma * math.sin(math.acos(G1 / gamma))
+        assert mu.sum().real == pytest.approx(trace, abs=1e-7)
+        assert abs(np.prod(mu)) == pytest.approx(R * R, rel=1e-7)
+        assert (np.min(mu.real) < -1.0) == crossed
+
+
+def test_continuation_locates_the_fold_only_with_the_section_off_the_impact():
+    """At the fold the impact falls on t = kT: at phase 0 continuation cannot pass it; with
+    the section at phase pi it locates it."""
+    found = {}
+    for psi in (0.0, math.pi):
+        p, z0, v0 = on_orbit(1.3, psi)
+        br = ns.continuation(p, "A", x0=z0, v0=v0, direction="down",
+                             bounds=(0.5 * G1 / W**2, 1.45 / W**2), section_phase=psi)
+        found[psi] = (br.attrs["status"], br.special_type.values, br["special_A"].values * W**2)
+    assert "cannot continue" in found[0.0][0] and found[0.0][1].size == 0
+    status, types, gammas = found[math.pi]
+    assert list(types) == [1] and "bounds" in status  # one fold, then out of the bounds
+    assert gammas[0] == pytest.approx(G1, abs=1e-9)
+
+
+def test_smooth_table_converges_to_the_impact_law():
+    """The compliant table restitutes r per contact; its period-one orbit tends to the exact
+    one as k_c grows, like the contact time, k_c^(-1/2)."""
+    p, z0, v0 = on_orbit(1.3)
+    errs = []
+    for kc in (1e5, 1e6, 1e7):
+        sec = ns.poincare(p.replace(k_c=kc), record=20, transient=200, method="smooth", x0=z0,
+                          v0=v0)
+        assert int(sec.period) == 1
+        errs.append(abs(float(sec.X[-1]) - z0) + abs(float(sec.V[-1]) - v0))
+    assert errs[2] < 3e-4 and errs[0] / errs[1] > 2.5 and errs[1] / errs[2] > 2.5
+
+
+def test_chatter_ends_in_sticking_not_zeno():
+    ds = ns.simulate(M.preset("period_one"), periods=50, method="exact")  # from rest
+    assert int(ds.regions_visited) & 0b10  # stuck on the table at some time
+    assert float(ds.min_X) >= -1e-12  # never below the table
+    assert float(ds.max_X) > 1e-3  # and launched again
