@@ -128,6 +128,38 @@ def test_any_periodic_forcing_through_the_local_time():
     np.testing.assert_allclose(ds.X.values, ref.y[0], atol=1e-8)
 
 
+def test_step_terms_are_not_taken_for_closed_forms_and_sign_differentiates():
+    """Coulomb friction -mu sign(V) (or a Piecewise step) has zero derivatives but is not a
+    constant: the mode has no closed form; its Jacobian is that of the smooth part."""
+    for law in ("mu*sign(V)", "mu*Piecewise((1, V > 0), (-1, True))"):
+        m = ns.model_from_equations(
+            "coulomb", states=("X", "V"), parameters={"mu": 0.1, "F0": 1.0, "omega": 1.3},
+            modes={"slip": ["V", f"-X - {law} + F0*cos(omega*t)"]}, method="exact")
+        assert not m.methods["exact"].closed_form
+        p = m.params()
+        ds = ns.simulate(p, periods=2, x0=0.5, v0=0.3, method="exact", samples_per_period=4)
+
+        def rhs(t, y):
+            return [y[1], -y[0] - 0.1 * np.sign(y[1]) + math.cos(1.3 * t)]
+        T = 2 * math.pi / 1.3
+        ref = solve_ivp(rhs, (0, 0.25 * T), [0.5, 0.3], rtol=1e-12, atol=1e-13, method="DOP853")
+        assert float(ds.X[1]) == pytest.approx(ref.y[0, -1], abs=1e-8)  # before V's sign flips
+
+
+def test_periodic_forcing_in_t_is_the_same_at_any_section_phase():
+    """A rectangular pulse in the time within the period: t is wrapped into [0, T), so a run
+    started at the section phase pi/2 follows the phase-0 run."""
+    m = ns.model_from_equations(
+        "pulse", states=("X", "V"), parameters={"xi": 0.2, "F0": 1.0, "omega": 1.0, "c": 0.3},
+        modes={"free": ["V", "-X - xi*V + F0*Piecewise((1, t < pi/omega), (0, True)) - c"]},
+        method="smooth")  # a parameter may be called c (or k, s, u, p)
+    kw = dict(method="smooth", rtol=1e-11, atol=1e-13)
+    a = ns.simulate(m.params(), periods=6, samples_per_period=4, **kw)
+    b = ns.simulate(m.params(), periods=5, samples_per_period=4, x0=float(a.X[1]),
+                    v0=float(a.V[1]), section_phase=math.pi / 2, **kw)
+    assert np.max(np.abs(b.X.values - a.X.values[1:1 + b.sizes["t"]])) < 1e-8
+
+
 @pytest.mark.parametrize("change, needle", [
     (dict(modes={"free": ["V", "-X + foo"]}), "mode free, dV/dt: unknown name 'foo'"),
     (dict(modes={"free": ["V", "-X +* 2"]}), "mode free, dV/dt: cannot parse"),
@@ -138,6 +170,10 @@ def test_any_periodic_forcing_through_the_local_time():
     (dict(guards={"gone": [("1 - X", "free")]}), "guards: unknown mode 'gone'"),
     (dict(guards={"free": [("1 - X*cos(omega*t)", "free")]}), "not affine"),
     (dict(parameters={"omega": 1.0, "t": 2.0}), "'t' cannot name"),
+    (dict(guards={"free": [("1 - X + Piecewise((0.5, V > 0), (0, True))", "free")]}),
+     "not affine"),
+    (dict(modes={"free": ["V", "-X + Piecewise((1, V > 0))"]}), "needs a last branch"),
+    (dict(methods={"exact": dict(modes={"free": ["V", "-X"]})}, rtol=1e-9), "per method"),
     (dict(parameters={"xi": 1.0}), "forcing frequency 'omega' must be a parameter"),
 ])
 def test_bad_equations_are_one_line_errors(change, needle):

@@ -73,7 +73,8 @@ def run(kernel, fns, p, opts, state, per_period, n_skip, n_out, X, V, R, M, Xmax
 
 @nb.njit(cache=True)
 def mode_holds(kernel, fns, p, opts, state):
-    """Does the mode carried in ``state`` still hold for parameters ``p`` (at t = 0)? Used
+    """Does the mode carried in ``state`` still hold for parameters ``p`` (at the section,
+    forcing phase ``opts[OPT_PHASE]``)? Used
     after a parameter change in a continuation sweep: mode borders move with parameters."""
     mode = int(state[ST_MODE])
     if kernel == KERNEL_SUPPORT_SMOOTH:
@@ -95,8 +96,11 @@ def mode_holds(kernel, fns, p, opts, state):
     pp[:] = p
     G = np.empty((MAX_GUARDS, n + 3))
     ng = fns[2](mode, pp, mem, G)
+    psi = opts[OPT_PHASE]  # t = t_s: the forcing phase of the section
+    c = math.cos(psi)
+    s = math.sin(psi)
     for k in range(ng):
-        g = G[k, n] + G[k, n + 1]
+        g = G[k, n] + G[k, n + 1] * c + G[k, n + 2] * s
         for i in range(n):
             g += G[k, i] * u[i]
         if g < 0.0:

@@ -299,6 +299,10 @@ def _doubled_orbit(params, param, start, method, tol, rtol, atol, section_phase=
     if typ != PERIOD_DOUBLING:
         raise ParameterError(f"start: special point {i} is a {SPECIAL_NAMES.get(typ, typ)}, "
                              f"not a period doubling")
+    if float(src.attrs.get("section_phase", 0.0)) != section_phase:
+        raise ParameterError(f"start: the branch was continued at section_phase = "
+                             f"{float(src.attrs.get('section_phase', 0.0)):g}, not "
+                             f"{section_phase:g}: give the same section_phase")
     if src.attrs.get("param") != param:
         raise ParameterError(f"start: the branch was continued in {src.attrs.get('param')}, "
                              f"not in {param}")
@@ -521,7 +525,7 @@ def two_parameter_curve(params, param: str, param2: str, values2, *, special: st
                     {"long_name": "how each branch ended"})},
         coords={param2: (param2, values2, {"long_name": s2.long_name, "units": s2.units}),
                 "n": np.arange(n)},
-        attrs=provenance_attrs(params, None, swept=(param, param2),
+        attrs=provenance_attrs(params, None, swept=(param, param2), section_phase=section_phase,
                                analysis="two_parameter_curve", param=param, param2=param2,
                                special=special, k=k),
     )

@@ -231,11 +231,11 @@ def resonance_curve(params: ParamsBase, omegas, *, method: str = "smooth", trans
                           v0=v0, settle=settle, resolution=resolution, branch_tol=branch_tol,
                           **freqs)
     if branches == "all":
-        _all_branches(ds, params, w_name, omegas, out, method)
+        _all_branches(ds, params, w_name, omegas, out, method, section_phase)
     return ds
 
 
-def _all_branches(ds, params, w_name, omegas, out, method):
+def _all_branches(ds, params, w_name, omegas, out, method, section_phase=0.0):
     """Add the continued period-1 branch (stable and unstable parts) and its special points."""
     from .continuation import FOLD, GRAZING, continuation
     up = 0
@@ -243,7 +243,7 @@ def _all_branches(ds, params, w_name, omegas, out, method):
     br = continuation(params.replace(**{w_name: float(omegas[0])}), w_name, x0=x0, v0=v0,
                       bounds=(float(omegas[0]), float(omegas[-1])),
                       step=min(0.01, 0.05 * float(omegas[-1] - omegas[0])),
-                      max_points=2000, method=method)
+                      max_points=2000, method=method, section_phase=section_phase)
     spec = params.model.param(w_name)
     ds[f"branch_{w_name}"] = ("branch_point", br[w_name].values,
                               {"long_name": spec.long_name, "units": spec.units})

@@ -3,9 +3,10 @@ any model, and the built-in models' specialised kernels).
 
 A kernel ``advance(p, opts, state, per_period, n_skip, n_out, X, V, R, M, Xmax, Xmin) -> status``
 (the generic one takes the model's compiled functions first: ``advance_generic(fns, p, ...)``)
-integrates from a forcing-period boundary (local time 0) over ``n_skip + n_out`` output
-intervals of length T / ``per_period`` (T = 2 pi / omega); the local time is reset to 0 at every
-period boundary, so the numbers do not depend on how a run is split into calls that each start
+integrates from a forcing-period boundary (local time t_s = ``opts[OPT_PHASE]`` / omega, 0
+by default; the specialised kernels know only 0) over ``n_skip + n_out`` output intervals of
+length T / ``per_period`` (T = 2 pi / omega); the local time is reset to t_s at every period
+boundary, so the numbers do not depend on how a run is split into calls that each start
 on a period boundary. For output k (0 <= k < n_out), at the end of interval ``n_skip + k``:
 
 * ``X[k], V[k]``  the state (u[0], u[1] of the model's state u);

@@ -9,8 +9,9 @@ signatures of :mod:`nonsmooth.integrate.contract`). It declares
   Compiled code reads a parameter by an index derived from the names in one place
   (:func:`param_index`), never by a hard-coded position;
 * the **forcing**: harmonic with frequency ``omega`` (a parameter name); the period
-  T = 2 pi / omega frames time (output intervals, the stroboscopic section at t = kT, and the
-  local time that restarts at 0 every period). Functions receive t and (c, s) = (cos omega t,
+  T = 2 pi / omega frames time (output intervals, the stroboscopic section at t = t_s + kT, and
+  the local time that restarts at t_s every period; t_s = section_phase / omega, 0 by
+  default, so t runs over [t_s, t_s + T)). Functions receive t and (c, s) = (cos omega t,
   sin omega t), so they never evaluate a cosine;
 * the **state** u of dimension n >= 2 (``state_names``; u[0] is the displacement X that
   analyses and plots show, u[1] its rate V), and ``n_memory`` slots of discrete memory ``mem``

@@ -17,8 +17,9 @@ It derives what the model interface (:mod:`nonsmooth.models.base`) asks for by h
   before the event) and ``initial`` (the first of the given (condition, mode) pairs that
   holds, else the first mode whose surfaces are all >= 0, else the first mode).
 
-In expressions: the state and parameter names, ``t`` (the time since the start of the current
-forcing period, so any function of it with period T = 2 pi / omega is a periodic forcing),
+In expressions: the state and parameter names, ``t`` (the time within the forcing period,
+0 <= t < T = 2 pi / omega, whatever the section phase: any function of it is a periodic
+forcing),
 ``pi`` and the functions sin, cos, tan, exp, log, sqrt, sinh, cosh, tanh, asin, acos, atan,
 atan2, Abs, sign, Min, Max, floor and Piecewise, and logistic(z) = 1 / (1 + exp(-z)) and
 softplus(y) = log(1 + exp(y)) for regularised laws (evaluated and differentiated without
@@ -35,6 +36,7 @@ from __future__ import annotations
 import hashlib
 import importlib.util
 import keyword
+import os
 import sys
 import tempfile
 import warnings
@@ -57,8 +59,7 @@ SMOOTH_STEPS = ("logistic", "softplus")
 #: models do): its RKF45 pieces are then accurate to round-off, not to the solver's rtol.
 EXACT_RTOL, EXACT_ATOL = 1e-12, 1e-14
 #: Names the generated code uses itself: a state or parameter may not take them.
-_RESERVED = {"t", "pi", "c", "s", "u", "p", "mem", "du", "J", "G", "k", "mode", "out", "math",
-             *FUNCTIONS, *SMOOTH_STEPS}
+_RESERVED = {"t", "pi", *FUNCTIONS, *SMOOTH_STEPS}  # (the generated code renames the rest)
 
 
 @dataclass(frozen=True)
@@ -114,8 +115,10 @@ def model_from_equations(name: str, *, states, parameters, modes: dict | None = 
         methods = {method: dict(modes=modes, guards=guards, initial=initial, rtol=rtol,
                                 atol=atol, description=description,
                                 flow_is_homeomorphism=flow_is_homeomorphism)}
-    elif modes is not None or guards is not None or initial is not None:
-        raise bad("give either methods={...} or modes/guards/initial, not both")
+    elif modes is not None or guards is not None or initial is not None or method != "exact" \
+            or rtol is not None or atol is not None or flow_is_homeomorphism:
+        raise bad("with methods={...}, give modes, guards, initial, rtol, atol and "
+                  "flow_is_homeomorphism per method, not as arguments")
     states = tuple(states)
     params = _parameters(parameters, bad)
     pnames = tuple(q.name for q in params)
@@ -132,7 +135,7 @@ def model_from_equations(name: str, *, states, parameters, modes: dict | None = 
         raise bad("at least one mode is needed")
     sym = {nm: sp.Symbol(nm, real=True) for nm in states + pnames}
     t = sp.Symbol("t", real=True)
-    C, S = sp.Symbol("_C", real=True), sp.Symbol("_S", real=True)
+    C, S = sp.Dummy("cos_omega_t", real=True), sp.Dummy("sin_omega_t", real=True)
     ctx = _Context(sp, sym, t, C, S, sym[omega], set(states), name)
     built = {}
     for mname, spec in methods.items():
@@ -180,8 +183,13 @@ def _method(sp, ctx, name, mname, spec, states, pnames, mode_names, closed_form,
             for i, (cond, m) in enumerate(spec.get("initial") or ())
             if _mode_index(m, own, bad) >= 0]
     linear = {m: ctx.linear(fields[m]) for m in own} if closed_form and n == 2 else {}
-    source = _source(sp, ctx, states, pnames, mode_names, own, fields, rows, branches, init,
-                     linear)
+    try:
+        source = _source(sp, ctx, states, pnames, mode_names, own, fields, rows, branches,
+                         init, linear)
+    except Exception as exc:  # noqa: BLE001 - an expression SymPy cannot print as Python
+        raise bad(f"method {mname}: cannot generate its functions "
+                  f"({type(exc).__name__}: {str(exc).splitlines()[0] if str(exc) else ''})"
+                  ) from None
     module = _load(f"{name}_{mname}", source)
     has_linear = any(v is not None for v in linear.values())
     rtol, atol = spec.get("rtol"), spec.get("atol")
@@ -270,8 +278,10 @@ class _Context:
 
     def parse(self, text, where):
         sp = self.sp
-        if isinstance(text, (int, float)) and not isinstance(text, bool):
-            return sp.Float(text) if isinstance(text, float) else sp.Integer(text)
+        if isinstance(text, bool):
+            return sp.true if text else sp.false
+        if isinstance(text, (int, float)):
+            return sp.Float(repr(text), 17) if isinstance(text, float) else sp.Integer(text)
         if isinstance(text, sp.Basic):
             expr = text.xreplace({s: self.local[s.name] for s in text.free_symbols
                                   if s.name in self.local})
@@ -293,6 +303,9 @@ class _Context:
         if unknown:
             raise self.bad(f"{where}: unknown name {unknown[0]!r} (states and parameters: "
                            f"{', '.join(k for k in self.sym)}; and t)")
+        for pw in expr.atoms(sp.Piecewise):
+            if not any(c is sp.true for _, c in pw.args):
+                raise self.bad(f"{where}: a Piecewise needs a last branch (value, True)")
         w, t = self.omega, self.t
         return expr.subs({self.sp.cos(w * t): self.C, self.sp.sin(w * t): self.S})
 
@@ -321,6 +334,10 @@ class _Context:
                                 for i, op in enumerate(node.ops)))
             if isinstance(node, ast.Constant) and isinstance(node.value, bool):
                 return sp.true if node.value else sp.false
+            if isinstance(node, ast.Compare) and isinstance(node.ops[0], (ast.Eq, ast.NotEq)):
+                a, b = (self.parse(ast.unparse(x), where) for x in (node.left,
+                                                                   node.comparators[0]))
+                return sp.Eq(a, b) if isinstance(node.ops[0], ast.Eq) else sp.Ne(a, b)
             return self.parse(ast.unparse(node), where)
         return walk(tree)
 
@@ -332,13 +349,15 @@ class _Context:
             raise self.bad(f"{where}: a surface may depend on time only through cos(omega t) "
                            f"and sin(omega t)")
         coef = [sp.diff(g, v) for v in var]
-        if any(c.free_symbols & set(var) for c in coef):
+        const = g.subs({v: 0 for v in var})
+        rest = sp.simplify(g - sum((c * v for c, v in zip(coef, var)), const))
+        if any(c.free_symbols & set(var) for c in coef) or rest.free_symbols & set(var) \
+                or rest != 0:
             raise self.bad(f"{where}: the surface {g} is not affine in the state and "
                            f"cos/sin(omega t) (curved surfaces are not supported yet)")
         if all(sp.simplify(c) == 0 for c in coef):  # (a surface of time alone is allowed)
             raise self.bad(f"{where}: the surface {g} has a zero gradient (it depends on "
                            f"neither the state nor cos/sin(omega t))")
-        const = g.subs({v: 0 for v in var})
         n = len(self.states)
         return coef[:n] + [const, coef[n], coef[n + 1]]
 
@@ -383,6 +402,12 @@ class _Context:
         b = a.subs({v: 0 for v in var})
         if b.free_symbols & {self.S, self.t}:
             return None
+        # an affine expression and nothing else (a step term, Piecewise in V say, has zero
+        # derivatives but is not constant), and a stiffness that is not identically 0 (free
+        # flight has no closed form of the oscillator)
+        if sp.simplify(a - (sum((c * v for c, v in zip(coef, var)), b))) != 0 \
+                or sp.simplify(coef[0]) == 0:
+            return None
         return -coef[0], -coef[1], b, coef[2]
 
 
@@ -405,9 +430,14 @@ def _source(sp, ctx, states, pnames, mode_names, own, fields, rows, branches, in
     printer = Printer({"fully_qualified_modules": True, "standard": "python3"})
 
     def plain(e):
-        """Heaviside (the derivative of Max/Min) as a Piecewise the printer writes."""
+        """Heaviside (the derivative of Max/Min) as a Piecewise the printer writes; the
+        derivatives of sign, floor and ceiling (zero almost everywhere) as 0."""
         e = sp.sympify(e).xreplace(names)
-        return e.replace(sp.Heaviside, lambda x, *h: sp.Piecewise((0, x < 0), (1, True)))
+        e = e.replace(sp.Heaviside, lambda x, *h: sp.Piecewise((0, x < 0), (1, True)))
+        e = e.replace(sp.DiracDelta, lambda *a: sp.Integer(0))
+        return e.replace(lambda x: isinstance(x, sp.Derivative)
+                         and isinstance(x.expr, (sp.floor, sp.ceiling, sp.sign)),
+                         lambda x: sp.Integer(0))
 
     def code(e):
         e = plain(e)
@@ -419,6 +449,15 @@ def _source(sp, ctx, states, pnames, mode_names, own, fields, rows, branches, in
 
     unpack_p = [f"    _p{i} = p[{i}]" for i in range(len(pnames))]
     unpack_u = [f"    _x{i} = u[{i}]" for i in range(n)]
+    # t: the time within the forcing period, 0 <= t < T, whatever the section phase (the
+    # kernel's periods run from t_s = phase / omega, so t < t_s + T < 2 T)
+    iw = pnames.index(ctx.omega.name)
+    exprs = [e for f in fields.values() for e in f] + [c for c, _ in init] + [
+        e for brs in branches.values() for br in brs for c, _, rs in br
+        for e in (c, *rs.values())]
+    uses_t = any(ctx.t in sp.sympify(e).free_symbols for e in exprs)
+    wrap_t = [f"    _T = 2.0 * math.pi / p[{iw}]", "    if t >= _T:", "        t -= _T"] \
+        if uses_t else []
 
     def by_mode(body_of, indent="    ", default="return 0"):
         out = []
@@ -430,17 +469,21 @@ def _source(sp, ctx, states, pnames, mode_names, own, fields, rows, branches, in
         return out + [f"{indent}{default}"]
 
     def cse_lines(exprs, targets):
-        reps, red = sp.cse([plain(e) for e in exprs],
-                           symbols=sp.numbered_symbols("_w"))
+        exprs = [plain(e) for e in exprs]
+        if any(e.has(sp.Piecewise) for e in exprs):  # branches must not be evaluated early
+            reps, red = [], exprs
+        else:
+            reps, red = sp.cse(exprs, symbols=sp.numbered_symbols("_w"))
         out = [f"{v} = {printer.doprint(e)}" for v, e in reps]
         return out + [f"{tg} = float({printer.doprint(e)})" for tg, e in zip(targets, red)]
 
     src = ["# generated by nonsmooth.models.equations: do not edit", "import math", "",
            "import numba", _HELPERS]
-    src += ["def field(mode, t, c, s, u, p, mem, du):", *unpack_u, *unpack_p]
+    src += ["def field(mode, t, c, s, u, p, mem, du):", *wrap_t, *unpack_u, *unpack_p]
     src += by_mode(lambda m: cse_lines(fields[m], [f"du[{i}]" for i in range(n)])
                    + ["return 0"])
-    src += ["", "", "def jacobian(mode, t, c, s, u, p, mem, J):", *unpack_u, *unpack_p]
+    src += ["", "", "def jacobian(mode, t, c, s, u, p, mem, J):", *wrap_t, *unpack_u,
+            *unpack_p]
     X = [ctx.sym[k] for k in states]
     src += by_mode(lambda m: cse_lines([sp.diff(f, x) for f in fields[m] for x in X],
                                        [f"J[{i}, {j}]" for i in range(n) for j in range(n)])
@@ -466,10 +509,12 @@ def _source(sp, ctx, states, pnames, mode_names, own, fields, rows, branches, in
                 out += tmp + [f"        u[{i}] = _r{i}" for i in reset] + [f"        return {new}"]
         return out + ["return mode"] if out else []
 
-    src += ["", "", "def transition(mode, k, t, c, s, u, p, mem):", *unpack_u, *unpack_p]
+    src += ["", "", "def transition(mode, k, t, c, s, u, p, mem):", *wrap_t, *unpack_u,
+            *unpack_p]
     src += by_mode(transition_body, default="return mode")
 
-    src += ["", "", "def initial(c, s, u, p, mem):", "    t = 0.0", *unpack_u, *unpack_p]
+    src += ["", "", "def initial(c, s, u, p, mem):",
+            f"    t = (math.atan2(s, c) % (2.0 * math.pi)) / p[{iw}]", *unpack_u, *unpack_p]
     src += [f"    if {code(cond)}:\n        return {m}" for cond, m in init]
     for m, mname in enumerate(mode_names):
         if mname not in own:
@@ -510,9 +555,10 @@ def _load(name: str, source: str):
     try:
         folder.mkdir(parents=True, exist_ok=True)
         if not path.exists() or path.read_text() != source:
-            tmp = path.with_suffix(f".tmp{id(source)}")
-            tmp.write_text(source)
-            tmp.replace(path)
+            fd, tmp = tempfile.mkstemp(dir=folder, suffix=".tmp")  # unique per process
+            with os.fdopen(fd, "w") as f:
+                f.write(source)
+            os.replace(tmp, path)  # atomic: another process's identical file is as good
     except OSError as exc:
         raise ParameterError(f"model {name}: cannot write its generated functions to "
                              f"{folder} ({exc.strerror or exc})") from None
@@ -522,5 +568,9 @@ def _load(name: str, source: str):
     spec = importlib.util.spec_from_file_location(modname, path)
     module = importlib.util.module_from_spec(spec)
     sys.modules[modname] = module
-    spec.loader.exec_module(module)
+    try:
+        spec.loader.exec_module(module)
+    except BaseException:
+        del sys.modules[modname]
+        raise
     return module
