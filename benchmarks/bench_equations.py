@@ -27,8 +27,7 @@ import argparse
 import time
 
 import nonsmooth as ns
-from nonsmooth import kernels
-from nonsmooth.models.base import KERNEL_GENERIC
+from bench_user_model import rate  # the same timing loop (this folder is on sys.path)
 
 FREE = "-xi*V - X - beta*X**3 + F0*cos(omega*t)"
 FORCE = "k_s*(X - gap) + c_s*V"
@@ -69,21 +68,6 @@ def impact_exact():
                     "r": dict(default=0.8, low=0.0, high=1.0)},
         modes={"free": ["V", "-omega0**2*X - xi*V + F0*cos(omega*t)"]},
         guards={"free": [ns.Guard("1 - X", "free", reset={"V": "-r*V"})]}, method="exact")
-
-
-def rate(params, method, periods, repeat):
-    solver = kernels.Solver(model=params.model, method=method)
-    p, opts, fns = params.pack(), solver.opts(), solver.fns
-
-    def once(n):
-        state = kernels.new_state(0.1, 0.0)
-        t0 = time.process_time()
-        code = kernels.run(KERNEL_GENERIC, fns, p, opts, state, 1, 0, n,
-                           *kernels.output_buffers(n))
-        return time.process_time() - t0, code
-
-    once(2)  # load / compile
-    return min(once(periods) for _ in range(repeat))
 
 
 def main():
