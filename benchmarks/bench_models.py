@@ -1,8 +1,8 @@
 """Benchmark: forcing periods per second of every built-in model and method, nonsmooth against
 scipy ``solve_ivp`` on the SAME model.
 
-For each built-in model (``support``, ``two_sided``, ``impact``, ``stick_slip``; a model whose
-module does not exist yet is skipped) and each method (``smooth``, ``exact``), one trajectory
+For each built-in model (``support``, ``two_sided``, ``impact``, ``stick_slip``,
+``bouncing_ball``, ``impact_2dof``; a model whose module does not exist yet is skipped) and each method (``smooth``, ``exact``), one trajectory
 from X = V = 0:
 
 * nonsmooth: ``Solver(model=m, method=...)`` through ``kernels.run`` (the model's specialised
@@ -60,6 +60,10 @@ CASES = (
      "defaults: unforced stick-slip cycle (omega = omega0)"),
     ("stick_slip", lambda m: m.params(omega=0.95),
      "defaults, omega = 0.95: stick-slip cycle, Coulomb slip in closed form"),
+    ("bouncing_ball", lambda m: m.preset("period_one"),
+     "Gamma = 1.3: the period-one orbit, one impact per period (free flight: RKF45)"),
+    ("impact_2dof", lambda m: m.params(),
+     "defaults: one impact per period, four states (RKF45 between impacts)"),
 )
 
 SCIPY = {"smooth": dict(method="RK45", rtol=1e-8, atol=1e-10),

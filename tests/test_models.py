@@ -12,7 +12,7 @@ from nonsmooth import status as st
 from nonsmooth.errors import ParameterError
 from nonsmooth.kernels import Solver, new_state, output_buffers, run
 
-BUILTIN = ("support", "two_sided", "impact", "stick_slip", "bouncing_ball")
+BUILTIN = ("support", "two_sided", "impact", "stick_slip", "bouncing_ball", "impact_2dof")
 
 #: parameters where each model switches every period (and settles quickly)
 CASES = {
@@ -21,6 +21,7 @@ CASES = {
     "impact": dict(xi=0.05, F0=3.0, omega=1.5),
     "stick_slip": dict(xi=0.05, F0=0.5, omega=0.8),
     "bouncing_ball": dict(A=1.3 / (4 * math.pi ** 2)),
+    "impact_2dof": dict(),
 }
 
 #: a small window of initial conditions around each model's motion, for basins
@@ -30,6 +31,7 @@ WINDOWS = {
     "impact": ((-1.0, 0.9), (-1.0, 1.0)),
     "stick_slip": ((-1.0, 1.5), (-0.5, 0.5)),
     "bouncing_ball": ((0.0, 0.2), (-0.5, 0.5)),
+    "impact_2dof": ((-1.0, 0.4), (-1.0, 1.0)),
 }
 
 

@@ -9,6 +9,7 @@ BUILTIN = {
     "impact": "nonsmooth.models.impact",
     "stick_slip": "nonsmooth.models.stick_slip",
     "bouncing_ball": "nonsmooth.models.bouncing_ball",
+    "impact_2dof": "nonsmooth.models.impact_2dof",
 }
 
 #: The model a command uses when none is named: the paper's.

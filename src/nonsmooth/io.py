@@ -250,3 +250,33 @@ def check_memory(nbytes: float, field: str, hint: str, fraction: float = 0.8,
 def finite_or_nan(x) -> float:
     x = float(x)
     return x if math.isfinite(x) else float("nan")
+
+
+def component_names(state_names) -> list[str]:
+    """The variable name of each state component in a result: ``X`` and ``V`` for u[0], u[1]
+    (whatever the model calls them: every result names them so), then the model's state
+    names (``u<i>`` where a name would clash with X or V)."""
+    names = ["X", "V"]
+    for i, nm in enumerate(tuple(state_names)[2:], start=2):
+        names.append(nm if nm not in ("X", "V") else f"u{i}")
+    return names
+
+
+def components(ds, prefix: str = "", suffix: str = ""):
+    """The state vector of a result as one DataArray with a trailing dimension ``component``
+    (coordinate: the model's state names, from the ``state_names`` attribute): the variables
+    ``<prefix>X<suffix>``, ``<prefix>V<suffix>`` and those of the further components, e.g.
+    ``components(ds)`` of ``simulate`` (t, component), ``components(ds, "orbit_")`` of
+    ``poincare``, ``components(ds, suffix="_section")`` of ``periodic_orbit``. Results are
+    written with one variable per component because CF gives a variable one unit."""
+    import xarray as xr
+    state = str(ds.attrs.get("state_names", "X V")).split()
+    names = [f"{prefix}{nm}{suffix}" for nm in component_names(state)]
+    missing = [nm for nm in names if nm not in ds.variables]
+    if missing:
+        raise KeyError(f"components: the dataset has no variable {missing[0]!r}")
+    dims = ds[names[0]].dims
+    data = np.stack([ds[nm].values for nm in names], axis=-1)
+    coords = {d: ds[d] for d in dims if d in ds.coords}
+    return xr.DataArray(data, dims=dims + ("component",),
+                        coords={**coords, "component": state}, name=f"{prefix}u{suffix}")

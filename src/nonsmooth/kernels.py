@@ -193,7 +193,8 @@ class Solver:
     def attrs(self) -> dict:
         m = self.spec
         o = self.opts()
-        a = {"model": self.model.name, "method": self.method, "rtol": float(o[OPT_RTOL]),
+        a = {"model": self.model.name, "state_names": " ".join(self.model.state_names),
+             "method": self.method, "rtol": float(o[OPT_RTOL]),
              "atol": float(o[OPT_ATOL]), "max_steps_per_period": int(self.max_steps),
              "section_phase": self.section_phase}
         if self.code == KERNEL_SUPPORT_SMOOTH:

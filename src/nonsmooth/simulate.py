@@ -10,7 +10,7 @@ import xarray as xr
 
 from . import status as st
 from .errors import IntegrationError, ParameterError
-from .integrate.contract import ST_MODE
+from .integrate.contract import ST_EXTRA, ST_MODE
 from .io import provenance_attrs
 from .kernels import Solver, new_state
 from .models.base import ParamsBase
@@ -47,15 +47,101 @@ def check_params(params) -> ParamsBase:
     return params
 
 
-def start_trajectory(params, x0, v0, method, rtol, atol, section_phase=0.0):
+def initial_u(model, x0=0.0, v0=0.0, u0=None) -> np.ndarray:
+    """The initial state u (all ``model.n`` components) from ``x0``, ``v0`` (u[0], u[1]; the
+    other components 0) or from ``u0``: a sequence of n numbers in the order of
+    ``model.state_names``, or a mapping {component name: value} (components it does not name
+    start at 0). One-line ParameterErrors name the field."""
+    n = model.n
+    u = np.zeros(n)
+    if u0 is None:
+        u[0] = check_float("x0", x0)
+        u[1] = check_float("v0", v0)
+        return u
+    if check_float("x0", x0) != 0.0 or check_float("v0", v0) != 0.0:
+        raise ParameterError("u0: give the initial state either as u0 or as x0, v0, not both")
+    names = tuple(model.state_names)
+    if isinstance(u0, str):
+        u0 = parse_components(u0, names, "u0")
+    if isinstance(u0, dict):
+        for name, value in u0.items():
+            if name not in names:
+                raise ParameterError(f"u0: unknown component {name!r} (model "
+                                     f"{model.name!r} has {', '.join(names)})")
+            u[names.index(name)] = check_float(f"u0[{name}]", value)
+        return u
+    try:
+        vals = list(np.asarray(u0, dtype=object).ravel())
+    except Exception:  # noqa: BLE001 - anything not array-like
+        raise ParameterError(f"u0: expected {n} numbers or a mapping of component names "
+                             f"({', '.join(names)}), got {u0!r}") from None
+    if len(vals) != n:
+        raise ParameterError(f"u0: expected {n} numbers ({', '.join(names)}), got {len(vals)}")
+    for i, value in enumerate(vals):
+        u[i] = check_float(f"u0[{names[i]}]", value)
+    return u
+
+
+def parse_components(text: str, names, field: str) -> dict:
+    """``"X=0.1,Y=-2"`` -> {"X": 0.1, "Y": -2.0} (the CLI's ``--u0``); one-line errors."""
+    out = {}
+    for part in filter(None, (t.strip() for t in text.split(","))):
+        name, sep, value = part.partition("=")
+        if not sep:
+            raise ParameterError(f"{field}: expected NAME=VALUE pairs separated by commas "
+                                 f"(components {', '.join(names)}), got {part!r}")
+        out[name.strip()] = value.strip()
+    if not out:
+        raise ParameterError(f"{field}: empty (components {', '.join(names)})")
+    return out
+
+
+def state_from_u(u) -> np.ndarray:
+    """The initial kernel state of the state vector u (mode classified by the kernel)."""
+    return new_state(float(u[0]), float(u[1]), tuple(float(x) for x in u[2:]))
+
+
+def start_trajectory(params, x0, v0, method, rtol, atol, section_phase=0.0, u0=None):
     """Validated single-trajectory set-up: (params, solver, packed params, kernel opts, initial
     kernel state). Every error names its field."""
     params = check_params(params)
-    x0 = check_float("x0", x0)
-    v0 = check_float("v0", v0)
+    u = initial_u(params.model, x0, v0, u0)
     solver = Solver(method=method, rtol=rtol, atol=atol, model=params.model,
                     section_phase=section_phase)
-    return params, solver, params.pack(), solver.opts(), new_state(x0, v0)
+    return params, solver, params.pack(), solver.opts(), state_from_u(u)
+
+
+def state_u(model, state) -> np.ndarray:
+    """The state vector u (n components) held in a kernel state."""
+    n = model.n
+    return np.concatenate([state[:2], state[ST_EXTRA:ST_EXTRA + n - 2]])
+
+
+def start_attrs(u) -> dict:
+    """Provenance of the initial state: x0, v0 (u[0], u[1]) and u0 (every component)."""
+    return {"x0": float(u[0]), "v0": float(u[1]), "u0": np.asarray(u, dtype=np.float64)}
+
+
+def component_names(model) -> list[str]:
+    """The variable name of each state component of ``model`` in a result (see
+    ``io.component_names``)."""
+    from .io import component_names as names_of
+    return names_of(model.state_names)
+
+
+def component_variables(model, dims, U, prefix: str = "", suffix: str = "",
+                        what: str = "") -> dict:
+    """Dataset variables ``<prefix><name><suffix>`` of the components u[2:] of ``U`` (last
+    axis: the components; X and V are written by each analysis), each with the model's units
+    and long name (CF: one unit per variable)."""
+    out = {}
+    names = component_names(model)
+    for i in range(2, model.n):
+        units = model.state_units[i] if len(model.state_units) > i else "1"
+        long = model.state_long_names[i] if len(model.state_long_names) > i else names[i]
+        out[f"{prefix}{names[i]}{suffix}"] = (dims, U[..., i], {
+            "long_name": f"{long}{what}", "units": units})
+    return out
 
 
 def renamed(name: str, value, old_name: str, old_value, default=None):
@@ -91,9 +177,11 @@ _SAMPLE_BYTES = 5 * 8 + 2
 def simulate(params: ParamsBase, *, periods: int, transient: int = 0,
              samples_per_period: int = SAMPLES_PER_PERIOD, x0: float = 0.0, v0: float = 0.0,
              method: str = "smooth", rtol: float = 1e-8, atol: float = 1e-10,
-             progress=None, section_phase: float = 0.0) -> xr.Dataset:
+             progress=None, section_phase: float = 0.0, u0=None) -> xr.Dataset:
     """Integrate one trajectory from (x0, v0) at t = 0 (forcing phase 0; at
-    t = section_phase / omega with ``section_phase``, the forcing phase in radians).
+    t = section_phase / omega with ``section_phase``, the forcing phase in radians); ``u0``:
+    the initial state of every component instead (n numbers in the order of the model's
+    ``state_names``, or a mapping {name: value}, the unnamed components 0).
 
     After ``transient`` whole forcing periods T = 2 pi/omega, the state is sampled at
     t = t0 + k T / samples_per_period, k = 0 ... periods * samples_per_period.
@@ -107,7 +195,9 @@ def simulate(params: ParamsBase, *, periods: int, transient: int = 0,
     through a thin band between two samples is not lost; CF flag_masks), ``X_max``, ``X_min``
     (the true extremes of X since the previous sample, interior extrema included; at the first
     sample X itself) and the scalars ``max_X``, ``min_X`` (true extremes over the whole
-    recorded run) and ``regions_visited`` (bit mask over the run). The run is integrated in
+    recorded run) and ``regions_visited`` (bit mask over the run); a model with more state
+    components has one variable each, named by its ``state_names`` (X and V are u[0], u[1];
+    ``nonsmooth.io.components(ds)`` assembles them over a dimension ``component``). The run is integrated in
     time slices; ``progress`` (None or False: silent; True: a progress bar with a time estimate on
     a terminal, plain lines elsewhere; or a callable ``progress(done, total)``) (in forcing
     periods) is called between them.
@@ -117,7 +207,7 @@ def simulate(params: ParamsBase, *, periods: int, transient: int = 0,
     from .io import check_memory, flag_attrs, format_bytes
     from .sweep import run_trajectories
     params, solver, p, opts, state = start_trajectory(params, x0, v0, method, rtol, atol,
-                                                      section_phase)
+                                                      section_phase, u0)
     periods = check_int("periods", periods, 1)
     transient = check_int("transient", transient, 0)
     spp = check_int("samples_per_period", samples_per_period, 1)
@@ -126,7 +216,7 @@ def simulate(params: ParamsBase, *, periods: int, transient: int = 0,
     check_memory(_SAMPLE_BYTES * (n + 1.0), big[0],
                  f"record fewer periods or samples per period ({n + 1} samples at "
                  f"{format_bytes(_SAMPLE_BYTES)} each)", size=(big[1], 1))
-    x0, v0 = float(state[0]), float(state[1])
+    u_start = state_u(params.model, state)
     P = p[None, :]
     total = transient + periods
     report = None if progress is None else (lambda d, _t: progress(d, total))
@@ -138,7 +228,7 @@ def simulate(params: ParamsBase, *, periods: int, transient: int = 0,
     if progress is not None:
         report = lambda d, _t: progress(transient + d, total)  # noqa: E731
     rec = run_trajectories(P, solver, state[None, :], per_period=spp, n_skip=0, n_out=n,
-                           workers=1, progress=report)
+                           workers=1, progress=report, components=True)
     if rec["status"][0] != st.OK:
         raise IntegrationError(f"simulate: integration failed: {st.message(rec['status'][0])}")
     X = np.concatenate([[state[0]], rec["X"][0]])
@@ -147,6 +237,7 @@ def simulate(params: ParamsBase, *, periods: int, transient: int = 0,
     M = np.concatenate([[1 << int(R[0])], rec["M"][0]]).astype(np.uint8)
     Xmax = np.concatenate([[state[0]], rec["Xmax"][0]])
     Xmin = np.concatenate([[state[0]], rec["Xmin"][0]])
+    U = np.concatenate([state_u(params.model, state)[None, :], rec["U"][0]])
     T = params.period
     t0 = transient * T + solver.section_phase / getattr(params, params.model.omega)
     t = t0 + np.arange(n + 1) * (T / spp)
@@ -172,10 +263,11 @@ def simulate(params: ParamsBase, *, periods: int, transient: int = 0,
                                               "units": "1"}),
             "regions_visited": ((), np.bitwise_or.reduce(M), dict(
                 masks, long_name="regions visited over the recorded run")),
+            **component_variables(params.model, "t", U),
         },
         coords={"t": ("t", t, {"long_name": "time", "units": "s"})},
         attrs=provenance_attrs(params, solver, analysis="simulate", periods=periods,
-                               transient=transient, samples_per_period=spp, x0=x0, v0=v0,
-                               forcing_period=T),
+                               transient=transient, samples_per_period=spp,
+                               **start_attrs(u_start), forcing_period=T),
     )
     return ds

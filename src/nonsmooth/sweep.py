@@ -19,7 +19,9 @@ import numpy as np
 
 from .errors import ParameterError
 from .kernels import Solver, run
-from .integrate.contract import MODEL_FNS_TYPE, N_STATE
+from .integrate.contract import MODEL_FNS_TYPE, N_STATE, OPT_N
+from .integrate.hybrid import advance_tangent
+from .models.base import KERNEL_GENERIC
 
 
 _F2 = nb.float64[:, :]
@@ -35,6 +37,26 @@ def _run_many(method, fns, P, opts, states, per_period, n_skip, n_out, X, V, R, 
         if status[i] == 0:
             status[i] = run(method, fns, P[i], opts, states[i], per_period, n_skip, n_out,
                                 X[i], V[i], R[i], M[i], Xmax[i], Xmin[i])
+
+
+@nb.njit(cache=True, parallel=True)
+def _run_many_components(fns, P, opts, states, per_period, n_skip, n_out, X, V, R, M, Xmax,
+                         Xmin, status, U):
+    """``_run_many`` on the generic kernel that also records every state component:
+    U[i, k, :] = u at output k of trajectory i (``hybrid.advance_tangent`` without tangent
+    vectors)."""
+    n = int(opts[OPT_N])
+    for i in nb.prange(P.shape[0]):
+        if status[i] == 0:
+            Ui = np.empty((n_out, n))
+            status[i] = advance_tangent(fns, P[i], opts, states[i], per_period, n_skip, n_out,
+                                        X[i], V[i], R[i], M[i], Xmax[i], Xmin[i],
+                                        np.zeros((n, 0)), np.zeros((0, 0)),
+                                        np.zeros(0, np.int64), 0, Ui, np.zeros(0),
+                                        np.zeros(4), np.zeros((0, 0)), np.zeros(0))
+            for k in range(n_out):
+                for c in range(n):
+                    U[i, k, c] = Ui[k, c]
 
 
 #: Seconds of work per compiled call of a long run: Ctrl-C (KeyboardInterrupt) and progress
@@ -127,7 +149,8 @@ def parallel_chunks(size: int = 8):
 
 
 def run_trajectories(P, solver: Solver, states, *, per_period: int, n_skip: int, n_out: int,
-                     workers: int | None = None, chunk: int | None = None, progress=None):
+                     workers: int | None = None, chunk: int | None = None, progress=None,
+                     components: bool = False):
     """Integrate ``len(P)`` trajectories (rows of packed parameters ``P``, initial kernel
     states ``states``, both modified copies are returned) over ``n_skip + n_out`` intervals
     of T/per_period, recording the last ``n_out`` (see ``integrate.contract``).
@@ -135,7 +158,9 @@ def run_trajectories(P, solver: Solver, states, *, per_period: int, n_skip: int,
     Returns a dict with X, V, R, M, Xmax, Xmin of shape (n, n_out), ``status`` (n,) and the
     final ``state`` (n, 5). The trajectories are run in chunks of ``chunk`` and each chunk in
     time slices (:class:`Slicer`); ``progress(done, total)`` is called after each slice, in
-    trajectory-periods.
+    trajectory-periods. ``components=True`` adds ``U`` (n, n_out, model.n): every state
+    component at each output (a model with n > 2 then runs on the generic kernel's entry that
+    records them; for n = 2, U is (X, V)).
     """
     P = np.ascontiguousarray(np.atleast_2d(np.asarray(P, dtype=np.float64)))
     states = np.array(states, dtype=np.float64, copy=True).reshape(-1, N_STATE)
@@ -149,6 +174,11 @@ def run_trajectories(P, solver: Solver, states, *, per_period: int, n_skip: int,
         "status": np.zeros(n, np.int64),
     }
     opts = solver.opts()
+    full = components and solver.model.n > 2
+    if full:
+        if solver.code != KERNEL_GENERIC:
+            raise ParameterError("components: a specialised kernel records X and V only")
+        out["U"] = np.empty((n, n_out, solver.model.n))
     nw = resolve_workers(workers)
     if chunk is None:
         chunk = max(4 * nw, n // 50 or 1)
@@ -163,18 +193,24 @@ def run_trajectories(P, solver: Solver, states, *, per_period: int, n_skip: int,
                 skip = max(0, min(k + m, n_skip) - k)
                 o0, o1 = max(k, n_skip) - n_skip, k + m - n_skip
                 o1 = max(o0, o1)
-                slicer.run(lambda _size: _run_many(
-                    solver.code, solver.fns, P[a:b], opts, states[a:b], per_period, skip, o1 - o0,
-                    out["X"][a:b, o0:o1], out["V"][a:b, o0:o1], out["R"][a:b, o0:o1],
-                    out["M"][a:b, o0:o1], out["Xmax"][a:b, o0:o1], out["Xmin"][a:b, o0:o1],
-                    out["status"][a:b]))
+                sl = (slice(a, b), slice(o0, o1))
+                args = (P[a:b], opts, states[a:b], per_period, skip, o1 - o0,
+                        *(out[key][sl] for key in ("X", "V", "R", "M", "Xmax", "Xmin")),
+                        out["status"][a:b])
+                if full:
+                    slicer.run(lambda _size: _run_many_components(solver.fns, *args,
+                                                                  out["U"][sl]))
+                else:
+                    slicer.run(lambda _size: _run_many(solver.code, solver.fns, *args))
                 k += m
                 if progress is not None:
                     progress((a * total + (b - a) * k) // per_period, n * total // per_period)
                 if k >= total:
                     break
     failed = out["status"] != 0
-    for key in ("X", "V", "Xmax", "Xmin"):
+    if components and not full:
+        out["U"] = np.stack([out["X"], out["V"]], axis=-1)
+    for key in ("X", "V", "Xmax", "Xmin") + (("U",) if components else ()):
         out[key][failed] = np.nan
     out["R"][failed] = -1
     out["M"][failed] = 0

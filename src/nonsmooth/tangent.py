@@ -58,27 +58,35 @@ class TangentSetup:
             s[ST_EXTRA + n - 2 + i] = z[n + q]
         return s
 
-    def run(self, p, state, periods, Y, L=None, transient=0, per_period=1, out=None):
+    def run(self, p, state, periods, Y, L=None, transient=0, per_period=1, out=None, U=None,
+            section=None):
         """Advance ``state`` in place over ``transient + periods`` periods carrying Y; with L
-        (periods x Y.shape[1]) re-orthonormalise each period and record the log norms.
-        Returns (status, outputs) with the kernel's output buffers of the recorded periods."""
+        (periods x Y.shape[1]) re-orthonormalise each period and record the log norms; with U
+        (outputs x n) record every state component; ``section`` = (H, SEC, U_sec, T_sec): a
+        section surface (see ``hybrid.advance_tangent``). Returns (status, outputs) with the
+        kernel's output buffers of the recorded periods."""
         n_out = periods * per_period
         bufs = out if out is not None else output_buffers(n_out)
         qr = 1 if L is not None else 0
         Lk = L if L is not None else np.zeros((0, 0))
         code = advance_tangent(self.fns, p, self.opts, state, per_period, transient * per_period,
-                               n_out, *bufs, Y, Lk, self.cmi, qr)
+                               n_out, *bufs, Y, Lk, self.cmi, qr,
+                               U if U is not None else np.zeros((0, 0)),
+                               *(section or (np.zeros(0), np.zeros(4), np.zeros((0, 0)),
+                                             np.zeros(0))))
         return int(code), bufs
 
 
 def period_map(setup: TangentSetup, p: np.ndarray, state: np.ndarray, k: int = 1):
     """The k-fold stroboscopic map from ``state`` (at a period boundary) and its Jacobian with
     respect to the section point z: returns (state after k periods, monodromy N x N, status,
-    output buffers of the k periods). ``state`` is not modified."""
+    output buffers of the k periods, followed by U: every state component after each period,
+    k x n). ``state`` is not modified."""
     s = state.copy()
     Y = np.eye(setup.N)
-    code, bufs = setup.run(p, s, k, Y)
-    return s, Y, code, bufs
+    U = np.empty((k, setup.n))
+    code, bufs = setup.run(p, s, k, Y, U=U)
+    return s, Y, code, (*bufs, U)
 
 
 def fd_period_map(setup: TangentSetup, p: np.ndarray, state: np.ndarray, k: int = 1,

@@ -219,9 +219,9 @@ def run_branches(params: ParamsBase, param: str, values, solver: Solver, *, dire
                  transient: int, record: int, x0: float, v0: float, settle: bool,
                  workers=None, progress=None, lyapunov: bool = False, store=None, engine=None,
                  analysis: str = "bifurcation", fingerprint: dict | None = None,
-                 first_window: bool = False):
+                 first_window: bool = False, extra=()):
     """Run continuation branches over sorted ``values``; ``directions`` lists "up", "down"
-    or "fresh". Returns dict of arrays (branch, value, n) in ascending value order, plus
+    or "fresh"; the first value starts from (x0, v0, ``extra`` = u[2:]). Returns dict of arrays (branch, value, n) in ascending value order, plus
     ``status`` and ``used`` (branch, value), ``S`` the kernel state after each value
     (branch, value, 5), the classification of :func:`summarize` (``period``, ``max_X``,
     ``min_X``, ``contact``), with ``lyapunov`` ``lambda1``, ``lambda1_stderr`` and ``motion``,
@@ -242,7 +242,7 @@ def run_branches(params: ParamsBase, param: str, values, solver: Solver, *, dire
     values = np.asarray(values, dtype=np.float64)
     nv = values.size
     rows = param_rows(params, param, values)
-    init = new_state(x0, v0)
+    init = new_state(x0, v0, tuple(extra))
     fresh = list(directions) == ["fresh"]
     orders = [np.arange(nv) if d != "down" else np.arange(nv)[::-1] for d in directions]
     bounds = chunk_bounds(nv, FRESH_CHUNK if fresh else BRANCH_CHUNK)
@@ -254,6 +254,7 @@ def run_branches(params: ParamsBase, param: str, values, solver: Solver, *, dire
     plan = Plan(analysis, {**(fingerprint or {}), "param": param, "values": values,
                            "directions": list(directions), "transient": transient,
                            "record": record, "x0": x0, "v0": v0, "settle": bool(settle),
+                           **({"u0_extra": [float(e) for e in extra]} if len(extra) else {}),
                            "params": dict(zip(params.model.param_names, rows[0])),
                            "solver": spec["solver"], "chunk": bounds[0][1] - bounds[0][0]},
                 nbr * nk, _branch_chunk, spec,
@@ -494,7 +495,7 @@ def bifurcation_diagram(params: ParamsBase, param: str, values, *, sweep: str = 
                         atol: float = 1e-10, settle: bool = True,
                         max_steps: int = 200_000, workers: int | None = None,
                         progress=None, lyapunov: bool | None = None, store=None,
-                        engine=None, section_phase: float = 0.0) -> xr.Dataset:
+                        engine=None, section_phase: float = 0.0, u0=None) -> xr.Dataset:
     """Orbit diagram of the stroboscopic section over ``param`` (any parameter of the model:
     omega, F0, omega_s, xi, xi_s, omega0, eta for support) at ``values`` (sorted ascending; each
     validated by the model).
@@ -502,7 +503,7 @@ def bifurcation_diagram(params: ParamsBase, param: str, values, *, sweep: str = 
     ``sweep``: "up" / "down" continue the state from value to value in increasing /
     decreasing order, "both" does both (in parallel), "fresh" restarts every value from
     (x0, v0) (all values in parallel). The first value of a continuation sweep starts from
-    (x0, v0). Each value: ``transient`` periods (ended early once the section has provably
+    (x0, v0) (or ``u0``: every component, see ``simulate``). Each value: ``transient`` periods (ended early once the section has provably
     settled when ``settle=True``, see ``analysis.poincare``), then ``record`` section points.
 
     A section still converging to a periodic orbit after that is integrated further before it
@@ -528,7 +529,7 @@ def bifurcation_diagram(params: ParamsBase, param: str, values, *, sweep: str = 
     from ..sweep import progress_callback
     progress = progress_callback(progress, "bifurcation")
     from ..chunks import check_engine
-    from ..simulate import check_float, check_int, check_params
+    from ..simulate import check_int, check_params, initial_u, start_attrs
     params = check_params(params)
     engine = check_engine(engine)
     if not isinstance(param, str):
@@ -540,19 +541,18 @@ def bifurcation_diagram(params: ParamsBase, param: str, values, *, sweep: str = 
     record = check_int("record", record, 1)
     check_sweep_memory(np.size(values), 2 if sweep == "both" else 1, record)
     values = check_values(param, values)
-    x0 = check_float("x0", x0)
-    v0 = check_float("v0", v0)
+    u = initial_u(params.model, x0, v0, u0)
     solver = Solver(model=params.model, method=method, rtol=rtol, atol=atol,
                     max_steps=max_steps, section_phase=section_phase)
     directions = {"up": ["up"], "down": ["down"], "both": ["up", "down"], "fresh": ["fresh"]}[sweep]
     from .stability import wants_lyapunov
     out = run_branches(params, param, values, solver, directions=directions,
-                       transient=transient, record=record, x0=x0, v0=v0, settle=settle,
-                       workers=workers, progress=progress,
+                       transient=transient, record=record, x0=u[0], v0=u[1], extra=u[2:],
+                       settle=settle, workers=workers, progress=progress,
                        lyapunov=wants_lyapunov(lyapunov, solver), store=store, engine=engine)
     return branches_dataset(params, param, values, solver, directions, out,
                             analysis="bifurcation", transient=transient, record=record,
-                            x0=x0, v0=v0, settle=settle, sweep_mode=sweep)
+                            **start_attrs(u), settle=settle, sweep_mode=sweep)
 
 
 #: Integer codes of the ``sweep`` coordinate (CF flag_values / flag_meanings).

@@ -35,7 +35,8 @@ from ..integrate.roots import illinois_point, illinois_update
 from ..io import provenance_attrs
 from ..kernels import output_buffers, run
 from ..models.base import KERNEL_GENERIC
-from ..simulate import check_float, check_int, start_trajectory
+from ..simulate import (check_float, check_int, component_variables, start_trajectory,
+                        state_u)
 from ..tangent import TangentSetup, period_map
 from .stability import NEUTRAL, _active, _section_state, periodic_orbit
 
@@ -167,7 +168,7 @@ class _Branch:
                  PERIOD_DOUBLING: float(np.real(np.prod(mu + 1.0))),
                  NEIMARK_SACKER: ns_test,
                  GRAZING: mx - self.level if self.level is not None else math.nan}
-        sec = (bufs[0][:self.k], bufs[1][:self.k])
+        sec = (bufs[0][:self.k], bufs[1][:self.k], bufs[6][:self.k])
         return dict(mu=mu, max_X=mx, min_X=mn, contact=contact, tests=tests, section=sec)
 
 
@@ -175,11 +176,11 @@ def continuation(params, param: str, *, start=None, k: int = 1, x0: float = 0.0,
                  v0: float = 0.0, transient: int = 0, direction: str = "up", step: float = 0.01,
                  max_step: float | None = None, bounds=None, max_points: int = 400,
                  method: str = "exact", tol: float = 1e-10, rtol: float = 1e-10,
-                 atol: float = 1e-12, section_phase: float = 0.0) -> xr.Dataset:
+                 atol: float = 1e-12, section_phase: float = 0.0, u0=None) -> xr.Dataset:
     """Follow a branch of k-periodic orbits in ``param`` from ``params``.
 
-    The first point is the orbit Newton's shooting finds from (x0, v0) (after ``transient``
-    periods) at ``params``; with ``start=(branch, i)``, a period-doubling point ``i`` of an
+    The first point is the orbit Newton's shooting finds from (x0, v0) (or ``u0``, every
+    component, see ``simulate``; after ``transient`` periods) at ``params``; with ``start=(branch, i)``, a period-doubling point ``i`` of an
     earlier branch Dataset instead (branch switching: the 2k-periodic orbit born there, found
     from the period-k orbit displaced along the eigenvector of the multiplier -1 on the side of
     the PD where it exists; ``k`` is then the earlier branch's k doubled and ``direction`` is
@@ -189,13 +190,15 @@ def continuation(params, param: str, *, start=None, k: int = 1, x0: float = 0.0,
     10 x step) until it leaves ``bounds`` (lo, hi), reaches ``max_points`` or cannot continue.
 
     Returns a Dataset over ``point``: the parameter, the section points (``X_section``,
-    ``V_section`` over ``point``, ``j``), the Floquet multipliers (``multiplier_real/imag/abs``),
+    ``V_section`` over ``point``, ``j``; a model with more state components has
+    ``<name>_section`` for each), the Floquet multipliers (``multiplier_real/imag/abs``),
     ``stable``, ``max_X``, ``min_X``, ``contact_fraction``, and the located ``special`` points
     over ``special`` (``special_type`` with CF flags, ``special_<param>``, the multiplier
     nearest the crossing and the point index after which it lies); attrs ``status`` (why the
     branch ended)."""
     params, solver, p0, opts, state = start_trajectory(params, x0, v0, method, rtol, atol,
-                                                       section_phase)
+                                                       section_phase, u0)
+    u_start = state_u(params.model, state)
     if not isinstance(param, str):
         raise ParameterError(f"param: expected a parameter name, got {param!r}")
     param = params.model.param(param).name
@@ -238,13 +241,14 @@ def continuation(params, param: str, *, start=None, k: int = 1, x0: float = 0.0,
         p0 = params.pack()
         br = _Branch(setup, p0, index, k, tol, level)
     else:
-        orb = periodic_orbit(params, k=k, x0=x0, v0=v0, method=method, transient=transient,
+        orb = periodic_orbit(params, k=k, u0=u_start, method=method, transient=transient,
                              tol=tol, rtol=rtol, atol=atol, samples_per_period=1,
                              section_phase=section_phase)
         if orb.attrs["status"] != "converged":
-            raise ParameterError(f"start: no period-{k} orbit found from (x0, v0) = ({x0:g}, "
-                                 f"{v0:g}) at {param} = {lam0:g} ({orb.attrs['status']}); try "
-                                 f"another start")
+            where = (f"(x0, v0) = ({u_start[0]:g}, {u_start[1]:g})" if len(u_start) == 2
+                     else f"u0 = ({', '.join(f'{x:g}' for x in u_start)})")
+            raise ParameterError(f"start: no period-{k} orbit found from {where} at {param} = "
+                                 f"{lam0:g} ({orb.attrs['status']}); try another start")
     N = setup.N
     s_start = _section_state(setup, p0, setup.z_of(_start_state(setup, p0, orb, state)), state)
     br.template = s_start
@@ -308,11 +312,16 @@ def _doubled_orbit(params, param, start, method, tol, rtol, atol, section_phase=
                              f"not in {param}")
     k = int(src.attrs["k"])
     lam = float(src[f"special_{param}"][i])
-    z = np.array([float(src.special_X_section[i]), float(src.special_V_section[i])])
+    from ..io import components
+    z = np.asarray(components(src, "special_", "_section").values[i], dtype=float)
+    n = params.model.n
+    if len(z) != n:
+        raise ParameterError(f"start: the branch has {len(z)} state components, the model "
+                             f"{n}")
     base = params.replace(**{param: lam})
-    orb = periodic_orbit(base, k=k, x0=z[0], v0=z[1], method=method, tol=tol, rtol=rtol,
+    orb = periodic_orbit(base, k=k, u0=z, method=method, tol=tol, rtol=rtol,
                          atol=atol, samples_per_period=1, section_phase=section_phase)
-    M = orb.monodromy.values[:2, :2]
+    M = orb.monodromy.values[:n, :n]
     w, V = np.linalg.eig(M)
     v = np.real(V[:, int(np.argmin(np.abs(w + 1.0)))])
     v /= np.linalg.norm(v)
@@ -322,13 +331,13 @@ def _doubled_orbit(params, param, start, method, tol, rtol, atol, section_phase=
             lam_t = lam + sg * dl * max(1.0, abs(lam))
             for amp in (1e-2, 3e-2, 1e-1):
                 zt = z + amp * scale * v
-                o2 = periodic_orbit(params.replace(**{param: lam_t}), k=2 * k, x0=zt[0],
-                                    v0=zt[1], method=method, tol=tol, rtol=rtol, atol=atol,
+                o2 = periodic_orbit(params.replace(**{param: lam_t}), k=2 * k, u0=zt,
+                                    method=method, tol=tol, rtol=rtol, atol=atol,
                                     samples_per_period=1, section_phase=section_phase)
                 if o2.attrs["status"] != "converged":
                     continue
-                xs, vs = o2.X_section.values, o2.V_section.values
-                spread = math.hypot(xs[0] - xs[k], vs[0] - vs[k])
+                us = components(o2, suffix="_section").values
+                spread = float(np.linalg.norm(us[0] - us[k]))
                 if spread > 1e-6 * scale:  # a genuine 2k orbit, not the k orbit again
                     return o2, lam_t, 2 * k, "up" if sg > 0 else "down"
     raise ParameterError(f"start: no period-{2 * k} orbit found near the period doubling at "
@@ -346,8 +355,8 @@ def _confirmed(typ, mu) -> bool:
 def _start_state(setup, p, orb, state):
     """The kernel state at the converged section point of ``orb`` (mode classified)."""
     z = np.zeros(setup.N)
-    z[0] = float(orb.X_section[0])
-    z[1] = float(orb.V_section[0])
+    from ..io import components
+    z[:setup.n] = components(orb, suffix="_section").values[0]
     s = setup.state_of(z, state)
     s[3] = -1.0
     run(KERNEL_GENERIC, setup.fns, p, setup.opts, s, 1, 0, 0, *output_buffers(0))
@@ -408,12 +417,14 @@ def _dataset(params, solver, param, k, pts, specials, status, N, direction, boun
     stable = np.array([bool(np.all(np.abs(m) < 1.0 - NEUTRAL)) for m in mus], np.int8)
     XS = np.array([f["section"][0] for _, f in pts])
     VS = np.array([f["section"][1] for _, f in pts])
+    n = params.model.n
+    US = np.array([f["section"][2] for _, f in pts]).reshape(len(pts), k, n)
     spec = params.model.param(param)
     sp_type = np.array([s[0] for s in specials], np.int8)
     sp_lam = np.array([s[2] for s in specials], float)
     sp_mu = np.array([s[3] for s in specials], complex)
     sp_after = np.array([s[1] for s in specials], np.int64)
-    sp_z = np.array([s[4][:2] for s in specials]).reshape(len(specials), 2)
+    sp_z = np.array([s[4][:n] for s in specials]).reshape(len(specials), n)
     sp_jump = np.array([s[5] for s in specials], np.int8)
     sp_mx = np.array([s[6] for s in specials], float)
     ds = xr.Dataset(
@@ -423,6 +434,8 @@ def _dataset(params, solver, param, k, pts, specials, status, N, direction, boun
                                               "units": "1"}),
             "V_section": (("point", "j"), VS, {"long_name": "section points V(jT)",
                                               "units": "1/s"}),
+            **component_variables(params.model, ("point", "j"), US, suffix="_section",
+                                  what=" at the section points"),
             "multiplier_real": (("point", "multiplier"), MU.real, {"units": "1"}),
             "multiplier_imag": (("point", "multiplier"), MU.imag, {"units": "1"}),
             "multiplier_abs": (("point", "multiplier"), absmu, {"units": "1"}),
@@ -445,6 +458,8 @@ def _dataset(params, solver, param, k, pts, specials, status, N, direction, boun
                 "long_name": "first section point X at the special point", "units": "1"}),
             "special_V_section": ("special", sp_z[:, 1], {
                 "long_name": "first section point V at the special point", "units": "1/s"}),
+            **component_variables(params.model, "special", sp_z, prefix="special_",
+                                  suffix="_section", what=" at the special point"),
             "special_max_X": ("special", sp_mx, {"long_name": "largest X over the orbit at "
                                                               "the special point", "units": "1"}),
             "special_jump": ("special", sp_jump, flag_attrs(
@@ -467,10 +482,11 @@ def _dataset(params, solver, param, k, pts, specials, status, N, direction, boun
 def two_parameter_curve(params, param: str, param2: str, values2, *, special: str = "fold",
                         k: int = 1, x0: float = 0.0, v0: float = 0.0, bounds=None,
                         step: float = 0.01, max_points: int = 400, method: str = "exact",
-                        tol: float = 1e-10, section_phase: float = 0.0) -> xr.Dataset:
+                        tol: float = 1e-10, section_phase: float = 0.0,
+                        u0=None) -> xr.Dataset:
     """A curve of special points in two parameters: for each value of ``param2`` in
     ``values2``, the branch in ``param`` is continued from the same start (``params``' value
-    of ``param``, Newton from (x0, v0)) over ``bounds`` and every located point of type
+    of ``param``, Newton from (x0, v0) or ``u0``) over ``bounds`` and every located point of type
     ``special`` ("fold", "period_doubling", "neimark_sacker" or "grazing") is recorded, so
     that e.g. the fold pair omega_b, omega_c of Fig. 6 is followed as omega_s changes, or the
     grazing curve of the contact-free orbit in (omega, F0).
@@ -495,7 +511,7 @@ def two_parameter_curve(params, param: str, param2: str, values2, *, special: st
     rows, stat = [], []
     for v in values2:
         p = params.replace(**{param2: float(v)})
-        br = continuation(p, param, k=k, x0=x0, v0=v0, bounds=bounds, step=step,
+        br = continuation(p, param, k=k, x0=x0, v0=v0, u0=u0, bounds=bounds, step=step,
                           max_points=max_points, method=method, tol=tol,
                           section_phase=section_phase)
         sel = br.special_type.values == typ

@@ -93,7 +93,7 @@ def _map_chunk(spec, i, carry, workers=None, progress=None):
         P = np.tile(base, (b - a, nx, 1))
         P[:, :, spec["ix"]] = xs[None, :]
         P[:, :, spec["iy"]] = ys[a:b, None]
-    init = new_state(spec["x0"], spec["v0"])
+    init = new_state(spec["x0"], spec["v0"], tuple(spec.get("u0_extra", ())))
     states = np.tile(init, (P.shape[0], 1))
     out = sweep_block(np.ascontiguousarray(P), solver, states, init, spec["transient"],
                       spec["settle_tol"], spec["record"], spec["lyapunov"], floquet=True,
@@ -111,8 +111,9 @@ def parameter_map(params: ParamsBase, x=("omega", 0.8, 1.0, 100), y=("F0", 0.15,
                   max_steps: int = 200_000, lyapunov: bool | None = None,
                   workers: int | None = None, progress=None, store=None,
                   engine=None, chunk: int | None = None,
-                  section_phase: float = 0.0) -> xr.Dataset:
+                  section_phase: float = 0.0, u0=None) -> xr.Dataset:
     """Map of the settled motion over a grid of two parameters (see the module docstring).
+    Points start from (x0, v0), or from ``u0`` (every component, see ``simulate``).
 
     ``x``, ``y``: (parameter, min, max, n) of the two axes (any parameters of the model, n >= 1
     values from min to max). ``start``: "fresh" or "continued" (along x). ``lyapunov`` (None:
@@ -135,7 +136,7 @@ def parameter_map(params: ParamsBase, x=("omega", 0.8, 1.0, 100), y=("F0", 0.15,
     progress = progress_callback(progress, "map")
     from ..chunks import Plan, check_engine, execute, plan_solver
     from ..io import check_memory
-    from ..simulate import check_float, check_int, check_params
+    from ..simulate import check_int, check_params, initial_u, start_attrs
     from .poincare import settle_tolerance
     from .stability import wants_lyapunov
     params = check_params(params)
@@ -147,8 +148,8 @@ def parameter_map(params: ParamsBase, x=("omega", 0.8, 1.0, 100), y=("F0", 0.15,
         raise ParameterError(f"start: expected one of {', '.join(STARTS)}, got {start!r}")
     transient = check_int("transient", transient, 0)
     record = check_int("record", record, 1)
-    x0 = check_float("x0", x0)
-    v0 = check_float("v0", v0)
+    u = initial_u(params.model, x0, v0, u0)
+    x0, v0 = float(u[0]), float(u[1])
     engine = check_engine(engine)
     for xv in (xs[0], xs[-1]):  # every constraint is an interval per parameter: the corners
         for yv in (ys[0], ys[-1]):
@@ -170,6 +171,7 @@ def parameter_map(params: ParamsBase, x=("omega", 0.8, 1.0, 100), y=("F0", 0.15,
     index = params.model.index
     spec = {"solver": plan_solver(solver, engine), "xs": xs, "ys": ys, "base": params.pack(),
             "ix": index[xname], "iy": index[yname], "start": start, "x0": x0, "v0": v0,
+            **({"u0_extra": [float(e) for e in u[2:]]} if len(u) > 2 else {}),
             "transient": transient, "record": record,
             "settle_tol": settle_tolerance(solver, settle), "lyapunov": lyap,
             "bounds": bounds}
@@ -191,7 +193,7 @@ def parameter_map(params: ParamsBase, x=("omega", 0.8, 1.0, 100), y=("F0", 0.15,
     return _dataset(params, solver, xname, xs, yname, ys,
                     {k: v.reshape(ny, nx) for k, v in out.items()},
                     dict(analysis="parameter_map", start=start, transient=transient,
-                         record=record, x0=x0, v0=v0, settle=settle, x_param=xname,
+                         record=record, **start_attrs(u), settle=settle, x_param=xname,
                          y_param=yname))
 
 

@@ -241,7 +241,7 @@ def poincare(params: ParamsBase, *, record: int | None = None, transient: int, x
              v0: float = 0.0, method: str = "smooth", rtol: float = 1e-8, atol: float = 1e-10,
              orbit_samples: int = 200, orbit_periods: int | None = None,
              settle: bool = False, progress=None, points: int | None = None,
-             lyapunov: bool | None = None, section_phase: float = 0.0) -> xr.Dataset:
+             lyapunov: bool | None = None, section_phase: float = 0.0, u0=None) -> xr.Dataset:
     """Stroboscopic Poincaré section of one trajectory from (x0, v0) at t = 0 (at the forcing
     phase ``section_phase``, radians: the section is then t = t_s + kT, omega t_s = that
     phase).
@@ -266,18 +266,27 @@ def poincare(params: ParamsBase, *, record: int | None = None, transient: int, x
     period was found), chaotic (lambda1 > 0 beyond 3 standard errors), quasi-periodic (no
     period, lambda1 within 3 errors of 0) or not settled.
 
+    ``u0``: the initial state of every component instead of (x0, v0) (see ``simulate``).
+    A model with more than two state components has a variable for each further one at the
+    section points (named by its ``state_names``) and on the phase portrait (``orbit_<name>``)
+    (the section is then integrated once more to record them: split-invariant kernels give
+    the same points); ``nonsmooth.io.components(ds)`` / ``(ds, prefix="orbit_")`` assemble
+    them.
+
     Raises IntegrationError if the trajectory fails (sweeps record failures instead).
     """
     from ..sweep import progress_callback
     progress = progress_callback(progress, "poincare")
     from ..io import check_memory, flag_attrs, status_flags
-    from ..simulate import check_int, renamed, start_trajectory
+    from ..simulate import (check_int, component_variables, renamed, start_attrs,
+                            start_trajectory, state_u)
     from ..sweep import run_trajectories
     from .bifurcation import follow, summarize
     record = renamed("record", record, "points", points)
     params, solver, p, opts, state = start_trajectory(params, x0, v0, method, rtol, atol,
-                                                      section_phase)
-    x0, v0 = float(state[0]), float(state[1])
+                                                      section_phase, u0)
+    u_start = state_u(params.model, state)
+    start_state = state.copy()
     record = check_int("record", record, 1)
     transient = check_int("transient", transient, 0)
     orbit_samples = check_int("orbit_samples", orbit_samples, 1)
@@ -297,18 +306,25 @@ def poincare(params: ParamsBase, *, record: int | None = None, transient: int, x
     period, mx, mn, contact = (a[0, 0] for a in summary)
     used = int(out["used"][0, 0])
     X, V = out["X"][0, 0], out["V"][0, 0]
+    if params.model.n > 2:  # the same section again, recording every component
+        sec = run_trajectories(p[None, :], solver, start_state[None, :], per_period=1,
+                               n_skip=used, n_out=record, workers=1, components=True)
+        U = sec["U"][0]
+    else:
+        U = np.stack([X, V], axis=-1)
 
     n_orb = orbit_periods or (period if period > 0 else 20)
     ns = n_orb * orbit_samples
     state = out["S"][0, 0]
     orb = run_trajectories(p[None, :], solver, state[None, :], per_period=orbit_samples,
-                           n_skip=0, n_out=ns, workers=1)
+                           n_skip=0, n_out=ns, workers=1, components=True)
     if orb["status"][0] != st.OK:
         raise IntegrationError(f"poincare: orbit integration failed: "
                                f"{st.message(orb['status'][0])}")
     oX = np.concatenate([[state[0]], orb["X"][0]])
     oV = np.concatenate([[state[1]], orb["V"][0]])
     oR = np.concatenate([[int(state[ST_MODE])], orb["R"][0]]).astype(np.int8)
+    oU = np.concatenate([state_u(params.model, state)[None, :], orb["U"][0]])
 
     T = params.period
     regions = flag_attrs(params.model.mode_names, dtype=np.int8)
@@ -337,6 +353,9 @@ def poincare(params: ParamsBase, *, record: int | None = None, transient: int, x
             "orbit_X": ("sample", oX, {"long_name": "phase-portrait displacement", "units": "1"}),
             "orbit_V": ("sample", oV, {"long_name": "phase-portrait velocity", "units": "1/s"}),
             "orbit_region": ("sample", oR, dict(regions, long_name="region of eq. 14")),
+            **component_variables(params.model, "n", U, what=" at the section"),
+            **component_variables(params.model, "sample", oU, prefix="orbit_",
+                                  what=" (phase portrait)"),
             **extra,
         },
         coords={
@@ -348,7 +367,7 @@ def poincare(params: ParamsBase, *, record: int | None = None, transient: int, x
                         {"long_name": "phase-portrait time", "units": "s"}),
         },
         attrs=provenance_attrs(params, solver, analysis="poincare", record=record,
-                               transient=transient, settle=settle, x0=x0, v0=v0,
+                               transient=transient, settle=settle, **start_attrs(u_start),
                                forcing_period=T, max_period=MAX_PERIOD,
                                period_tolerance=section_tolerance(
                                    rtol, atol, max(np.max(np.abs(X)), np.max(np.abs(V)))),

@@ -168,10 +168,10 @@ def resonance_curve(params: ParamsBase, omegas, *, method: str = "smooth", trans
                     resolution: float = 1e-4, branch_tol: float = 1e-3,
                     workers: int | None = None, progress=None,
                     branches: str = "stable", store=None, engine=None,
-                    section_phase: float = 0.0) -> xr.Dataset:
+                    section_phase: float = 0.0, u0=None) -> xr.Dataset:
     """Resonance curve over the forcing frequencies ``omegas`` (sorted ascending), swept up and
     down with continuation (see :func:`.bifurcation.bifurcation_diagram` for transient, record,
-    settle). Returns a Dataset over (sweep, omega) with ``max_X``, ``min_X``, ``period``,
+    settle; ``u0`` for every component of the start, see ``simulate``). Returns a Dataset over (sweep, omega) with ``max_X``, ``min_X``, ``period``,
     ``contact``, ``status`` and the section ``X``, ``V``; attrs ``omega_a``, ``omega_b``,
     ``omega_c`` (NaN when absent) refined to ``resolution``, with ``*_bracket`` attrs
     (definitions in the module docstring).
@@ -193,7 +193,7 @@ def resonance_curve(params: ParamsBase, omegas, *, method: str = "smooth", trans
     from ..sweep import progress_callback
     progress = progress_callback(progress, "resonance")
     from ..chunks import check_engine
-    from ..simulate import check_float, check_int, check_params
+    from ..simulate import check_float, check_int, check_params, initial_u, start_attrs
     params = check_params(params)
     engine = check_engine(engine)
     transient = check_int("transient", transient, 0)
@@ -203,8 +203,7 @@ def resonance_curve(params: ParamsBase, omegas, *, method: str = "smooth", trans
     omegas = check_values(w_name, omegas)
     for w in (omegas[0], omegas[-1]):
         params.replace(**{w_name: float(w)})
-    x0 = check_float("x0", x0)
-    v0 = check_float("v0", v0)
+    u = initial_u(params.model, x0, v0, u0)
     resolution = check_float("resolution", resolution)
     if resolution <= 0:
         raise ParameterError(f"resolution: must be > 0, got {resolution}")
@@ -216,9 +215,9 @@ def resonance_curve(params: ParamsBase, omegas, *, method: str = "smooth", trans
     solver = Solver(method=method, rtol=rtol, atol=atol,
                     model=params.model, section_phase=section_phase)
     out = run_branches(params, w_name, omegas, solver, directions=["up", "down"],
-                       transient=transient, record=record, x0=x0, v0=v0, settle=settle,
-                       workers=workers, progress=progress, store=store, engine=engine,
-                       analysis="resonance", first_window=True)
+                       transient=transient, record=record, x0=u[0], v0=u[1], extra=u[2:],
+                       settle=settle, workers=workers, progress=progress, store=store,
+                       engine=engine, analysis="resonance", first_window=True)
     # the jumps are refined from the sweeps' first recorded windows (as before the sections
     # still converging were extended)
     first = {"Xmax": out.pop("first_max_X")[..., None], "S": out.pop("first_S"),
@@ -227,8 +226,8 @@ def resonance_curve(params: ParamsBase, omegas, *, method: str = "smooth", trans
                                        record=record, settle=settle, workers=workers,
                                        resolution=resolution, branch_tol=branch_tol)
     ds = branches_dataset(params, w_name, omegas, solver, ["up", "down"], out,
-                          analysis="resonance", transient=transient, record=record, x0=x0,
-                          v0=v0, settle=settle, resolution=resolution, branch_tol=branch_tol,
+                          analysis="resonance", transient=transient, record=record,
+                          **start_attrs(u), settle=settle, resolution=resolution, branch_tol=branch_tol,
                           **freqs)
     if branches == "all":
         _all_branches(ds, params, w_name, omegas, out, method, section_phase)
@@ -240,7 +239,11 @@ def _all_branches(ds, params, w_name, omegas, out, method, section_phase=0.0):
     from .continuation import FOLD, GRAZING, continuation
     up = 0
     x0, v0 = float(out["X"][up, 0, -1]), float(out["V"][up, 0, -1])
-    br = continuation(params.replace(**{w_name: float(omegas[0])}), w_name, x0=x0, v0=v0,
+    u0 = None
+    if params.model.n > 2:  # the state after the first value: every component
+        from ..simulate import state_u
+        u0, x0, v0 = state_u(params.model, out["S"][up, 0]), 0.0, 0.0
+    br = continuation(params.replace(**{w_name: float(omegas[0])}), w_name, x0=x0, v0=v0, u0=u0,
                       bounds=(float(omegas[0]), float(omegas[-1])),
                       step=min(0.01, 0.05 * float(omegas[-1] - omegas[0])),
                       max_points=2000, method=method, section_phase=section_phase)

@@ -29,7 +29,8 @@ from ..integrate.hybrid import advance_tangent
 from ..io import check_memory, provenance_attrs
 from ..kernels import mode_holds, output_buffers, run
 from ..models.base import KERNEL_GENERIC
-from ..simulate import check_float, check_int, start_trajectory
+from ..simulate import (check_float, check_int, component_variables, start_attrs,
+                        start_trajectory, state_u)
 from ..tangent import TangentSetup, period_map
 
 #: Lyapunov verdicts (CF flag values of ``lyapunov_class``).
@@ -87,8 +88,10 @@ def _checkpoints(periods: int, n_max: int = 500) -> np.ndarray:
 
 def lyapunov(params, *, periods: int = 10000, transient: int = 1000, x0: float = 0.0,
              v0: float = 0.0, method: str = "smooth", rtol: float = 1e-8, atol: float = 1e-10,
-             blocks: int = 20, progress=None, section_phase: float = 0.0) -> xr.Dataset:
-    """Lyapunov spectrum of the trajectory from (x0, v0), any model.
+             blocks: int = 20, progress=None, section_phase: float = 0.0,
+             u0=None) -> xr.Dataset:
+    """Lyapunov spectrum of the trajectory from (x0, v0) (or from ``u0``, every component, see
+    ``simulate``), any model.
 
     The trajectory first runs ``transient`` forcing periods (the last ``ALIGN`` of them with
     the tangent vectors, so that they are aligned when recording starts); then the n tangent
@@ -110,7 +113,8 @@ def lyapunov(params, *, periods: int = 10000, transient: int = 1000, x0: float =
     from ..sweep import progress_callback
     progress = progress_callback(progress, "lyapunov")
     params, solver, p, opts, state = start_trajectory(params, x0, v0, method, rtol, atol,
-                                                      section_phase)
+                                                      section_phase, u0)
+    u_start = state_u(params.model, state)
     periods = check_int("periods", periods, 1)
     transient = check_int("transient", transient, 0)
     blocks = check_int("blocks", blocks, 2)
@@ -190,7 +194,7 @@ def lyapunov(params, *, periods: int = 10000, transient: int = 1000, x0: float =
         coords={"i": ("i", i, {"long_name": "exponent index (largest first)"}),
                 "period": ("period", pts, {"long_name": "recorded forcing periods"})},
         attrs=provenance_attrs(params, solver, analysis="lyapunov", periods=periods,
-                               transient=transient, x0=float(x0), v0=float(v0), blocks=blocks,
+                               transient=transient, **start_attrs(u_start), blocks=blocks,
                                forcing_period=T, state_names=" ".join(params.model.state_names),
                                verdict=VERDICTS[cls]),
     )
@@ -210,9 +214,11 @@ def _section_state(setup, p, z, template):
 def periodic_orbit(params, *, k: int = 1, x0: float = 0.0, v0: float = 0.0,
                    method: str = "exact", transient: int = 0, tol: float = 1e-10,
                    max_iter: int = 40, rtol: float = 1e-10, atol: float = 1e-12,
-                   samples_per_period: int = 200, section_phase: float = 0.0) -> xr.Dataset:
+                   samples_per_period: int = 200, section_phase: float = 0.0,
+                   u0=None) -> xr.Dataset:
     """A k-periodic orbit (fixed point of the k-fold stroboscopic map), stable or unstable, by
-    Newton shooting from (x0, v0) (after ``transient`` periods).
+    Newton shooting from (x0, v0) (or from ``u0``, every component, see ``simulate``; after
+    ``transient`` periods).
 
     Newton's iteration on F(z) = P^k(z) - z with the monodromy M = dP^k/dz from the tangent
     kernel (F' = M - I): quadratic convergence; a step that does not reduce |F| is halved up
@@ -223,14 +229,16 @@ def periodic_orbit(params, *, k: int = 1, x0: float = 0.0, v0: float = 0.0,
     (largest modulus first), ``stable`` (all |mu| < 1), ``max_X``, ``min_X`` over the orbit
     (interior extrema), ``contact_fraction`` (fraction of the orbit's samples in the model's
     contact modes), the orbit itself (``X``, ``V``, ``mode`` over ``t``, one period k T at
-    ``samples_per_period`` per period), and attrs ``status`` ("converged", "max_iter",
+    ``samples_per_period`` per period; a model with more state components has one variable
+    each, ``<name>_section`` over ``point`` and ``<name>`` over ``t``), and attrs ``status`` ("converged", "max_iter",
     "diverged", "integration failed: ...", "singular", "not confirmed: ..."), ``iterations``,
     ``residual`` and ``confirmation_residual``: a converged orbit is integrated once more,
     sampled ``samples_per_period`` times a period (so with other steps than Newton's), and is
     reported converged only if it closes on itself to ``CONFIRM_TOL`` (1 + |z|).
     Bad input raises one-line ParameterErrors; a failed search is a status, not an error."""
     params, solver, p, opts, state = start_trajectory(params, x0, v0, method, rtol, atol,
-                                                      section_phase)
+                                                      section_phase, u0)
+    u_start = state_u(params.model, state)
     k = check_int("k", k, 1)
     transient = check_int("transient", transient, 0)
     max_iter = check_int("max_iter", max_iter, 1)
@@ -283,20 +291,14 @@ def periodic_orbit(params, *, k: int = 1, x0: float = 0.0, v0: float = 0.0,
         if not np.all(np.isfinite(dz)):
             status = "diverged"
             break
-        lam = 1.0
-        accepted = False
-        for _ in range(13):  # damped step: accept the first that reduces |F|
-            zt = z + lam * dz
+        def trial(zt):
             st_t = _section_state(setup, p, zt, s0)
             s1t = st_t.copy()  # the k-fold map without the tangent (a line-search trial)
             code_t = run(KERNEL_GENERIC, setup.fns, p, opts, s1t, 1, k, 0, *output_buffers(0))
-            if code_t == st.OK:
-                rt = float(np.linalg.norm(setup.z_of(s1t) - zt))
-                if rt < res:
-                    accepted = True
-                    break
-            lam *= 0.5
-        if not accepted:
+            return st_t, (float(np.linalg.norm(setup.z_of(s1t) - zt)) if code_t == st.OK
+                          else math.inf)
+        zt, st_t = damped_step(z, dz, res, trial)
+        if zt is None:
             status = "diverged"
             break
         template = st_t
@@ -316,7 +318,8 @@ def periodic_orbit(params, *, k: int = 1, x0: float = 0.0, v0: float = 0.0,
     s_orbit = _section_state(setup, p, z, template)
     run(KERNEL_GENERIC, setup.fns, p, opts, s_orbit, 1, 0, 0, *output_buffers(0))  # classify
     start = s_orbit.copy()
-    code = run(KERNEL_GENERIC, setup.fns, p, opts, s_orbit, spp, 0, n_s, *bufs)
+    U = np.empty((n_s, setup.n))
+    code, _ = setup.run(p, s_orbit, k, np.zeros((N, 0)), per_period=spp, out=bufs, U=U)
     Xs, Vs, R, Mk, Xmax, Xmin = bufs
     if code != st.OK:
         Xs[:] = np.nan
@@ -331,6 +334,9 @@ def periodic_orbit(params, *, k: int = 1, x0: float = 0.0, v0: float = 0.0,
     X = np.concatenate([[start[0]], Xs])
     V = np.concatenate([[start[1]], Vs])
     R = np.concatenate([[int(start[ST_MODE])], R]).astype(np.int8)
+    U = np.concatenate([state_u(params.model, start)[None, :], U])
+    if code != st.OK:
+        U[:] = np.nan
     T = params.period
     t = np.arange(n_s + 1) * (T / spp)
     cmask = params.model.contact_modes
@@ -369,6 +375,9 @@ def periodic_orbit(params, *, k: int = 1, x0: float = 0.0, v0: float = 0.0,
             "X": ("t", X, {"long_name": params.model.state_long_names[0]
                            if params.model.state_long_names else "X", "units": "1"}),
             "V": ("t", V, {"long_name": "velocity dX/dt", "units": "1/s"}),
+            **component_variables(params.model, "point", U[::spp][:k], suffix="_section",
+                                  what=" at the section t = jT"),
+            **component_variables(params.model, "t", U),
             "mode": ("t", R, {"long_name": "mode at t",
                               "flag_values": np.arange(len(params.model.mode_names),
                                                        dtype=np.int8),
@@ -376,8 +385,8 @@ def periodic_orbit(params, *, k: int = 1, x0: float = 0.0, v0: float = 0.0,
         },
         coords={"point": np.arange(k), "multiplier": np.arange(1, len(mu) + 1),
                 "t": ("t", t, {"long_name": "time from the section point", "units": "s"})},
-        attrs=provenance_attrs(params, solver, analysis="periodic_orbit", k=k, x0=float(x0),
-                               v0=float(v0), transient=transient, tol=tol,
+        attrs=provenance_attrs(params, solver, analysis="periodic_orbit", k=k,
+                               **start_attrs(u_start), transient=transient, tol=tol,
                                status=status, iterations=it, residual=res,
                                confirmation_residual=confirm,
                                converged=int(converged),
@@ -386,6 +395,20 @@ def periodic_orbit(params, *, k: int = 1, x0: float = 0.0, v0: float = 0.0,
                                forcing_period=T),
     )
     return ds
+
+
+def damped_step(z, dz, res, trial, halvings: int = 12):
+    """Damped Newton: the first of z + dz, z + dz/2, ... (``halvings`` halvings) whose
+    ``trial(zt) -> (state, residual)`` has a residual below ``res``; returns (zt, state), or
+    (None, None) when none does."""
+    lam = 1.0
+    for _ in range(halvings + 1):
+        zt = z + lam * dz
+        state, r = trial(zt)
+        if r < res:
+            return zt, state
+        lam *= 0.5
+    return None, None
 
 
 def _active(M, n):
@@ -420,7 +443,8 @@ def _lambda1_many(fns, P, opts, states, align, periods, N, cmi, logs, status, Ys
         L = np.empty((periods, 1))
         X, V, R, M, Xa, Xb = _period_outputs(periods)
         status[i] = advance_tangent(fns, P[i], opts, states[i], 1, align, periods, X, V, R, M,
-                                    Xa, Xb, Y, L, cmi, 1)
+                                    Xa, Xb, Y, L, cmi, 1, np.zeros((0, 0)), np.zeros(0),
+                                    np.zeros(4), np.zeros((0, 0)), np.zeros(0))
         for k in range(periods):
             logs[i, k] = L[k, 0]
         for r in range(N):
@@ -494,7 +518,8 @@ def _monodromy_many(fns, P, opts, states, k, N, cmi, mono, status):
         m = k[i]
         X, V, R, M, Xa, Xb = _period_outputs(m)
         status[i] = advance_tangent(fns, P[i], opts, states[i], 1, 0, m, X, V, R, M, Xa, Xb,
-                                    Y, np.zeros((0, 0)), cmi, 0)
+                                    Y, np.zeros((0, 0)), cmi, 0, np.zeros((0, 0)),
+                                    np.zeros(0), np.zeros(4), np.zeros((0, 0)), np.zeros(0))
         for a in range(N):
             for b in range(N):
                 mono[i, a, b] = Y[a, b]

@@ -9,7 +9,7 @@ import typer
 
 from ..errors import ParameterError
 from .app import app
-from .common import (DEFAULT_MODEL, SectionPhaseOpt, AtolOpt, DaskOpt, MethodOpt, ModelOpt, OutOpt, PlotOpt, PresetOpt, RtolOpt, SetOpt,
+from .common import (ShowOpt, U0Opt, DEFAULT_MODEL, SectionPhaseOpt, AtolOpt, DaskOpt, MethodOpt, ModelOpt, OutOpt, PlotOpt, PresetOpt, RtolOpt, SetOpt,
                      WorkersOpt, check_outputs, chunk_store, echo_written, load_params,
                      preset_label, require_output, resolve_method, save_outputs)
 
@@ -80,11 +80,13 @@ def poincare_cmd(
     transient: TransientOpt = 500,
     x0: X0Opt = 0.0,
     v0: V0Opt = 0.0,
+    u0: U0Opt = None,
     method: MethodOpt = None,
     rtol: RtolOpt = 1e-8,
     atol: AtolOpt = 1e-10,
     section_phase: SectionPhaseOpt = 0.0,
     orbit_samples: Annotated[int, typer.Option(help="phase-portrait samples per period")] = 200,
+    show: ShowOpt = None,
     out: OutOpt = None,
     plot: PlotOpt = None,
 ):
@@ -100,14 +102,16 @@ def poincare_cmd(
     preset = preset_label(params, preset, "table3")
     check_int("record", record, 1)
     check_int("transient", transient, 0)
+    from ..plot.common import check_show
+    pair = check_show(show, params.model.state_names)
     require_output(out, plot)
     check_outputs(out, plot)
     with _progress("poincare") as prog:
-        ds = poincare(params, record=record, transient=transient, x0=x0, v0=v0, method=method,
+        ds = poincare(params, record=record, transient=transient, x0=x0, v0=v0, u0=u0, method=method,
                       rtol=rtol, atol=atol, section_phase=section_phase, orbit_samples=orbit_samples,
                       progress=prog)
     from ..plot.poincare import plot_poincare
-    save_outputs(ds, preset, out, plot, plot_poincare)
+    save_outputs(ds, preset, out, plot, lambda d: plot_poincare(d, show=pair))
     typer.echo(f"{preset}: {period_text(int(ds.period))}, contact {int(ds.contact)}, "
                f"max X = {float(ds.max_X):.6g}, min X = {float(ds.min_X):.6g}")
     echo_written(out, plot)
@@ -129,6 +133,7 @@ def bifurcation_cmd(
     record: Annotated[int, typer.Option("--record", help="section points recorded per value")] = 200,
     x0: X0Opt = 0.0,
     v0: V0Opt = 0.0,
+    u0: U0Opt = None,
     method: MethodOpt = None,
     rtol: RtolOpt = 1e-8,
     atol: AtolOpt = 1e-10,
@@ -160,7 +165,7 @@ def bifurcation_cmd(
     store, engine = chunk_store(out, dask)
     with _progress(f"bifurcation {param} ({sweep})") as prog:
         ds = bifurcation_diagram(params, param, values, sweep=sweep, transient=transient,
-                                 record=record, method=method, x0=x0, v0=v0, rtol=rtol,
+                                 record=record, method=method, x0=x0, v0=v0, u0=u0, rtol=rtol,
                                  atol=atol, section_phase=section_phase, settle=settle,
                                  workers=workers, progress=prog, store=store, engine=engine)
     from ..plot.bifurcation import plot_bifurcation
@@ -182,6 +187,7 @@ def resonance_cmd(
     record: Annotated[int, typer.Option("--record", help="periods recorded per value")] = 50,
     x0: X0Opt = 0.0,
     v0: V0Opt = 0.0,
+    u0: U0Opt = None,
     method: MethodOpt = None,
     rtol: RtolOpt = 1e-8,
     atol: AtolOpt = 1e-10,
@@ -215,7 +221,7 @@ def resonance_cmd(
     store, engine = chunk_store(out, dask)
     with _progress("resonance (up and down)") as prog:
         ds = resonance_curve(params, omegas, method=method, transient=transient, record=record,
-                             x0=x0, v0=v0, rtol=rtol, atol=atol, section_phase=section_phase,
+                             x0=x0, v0=v0, u0=u0, rtol=rtol, atol=atol, section_phase=section_phase,
                              settle=settle, resolution=resolution, workers=workers,
                              progress=prog, branches="all" if all_branches else "stable",
                              store=store, engine=engine)

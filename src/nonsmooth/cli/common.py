@@ -39,6 +39,14 @@ SectionPhaseOpt = Annotated[float, typer.Option(
     "--section-phase", help="forcing phase (radians, 0 <= phase < 2 pi) of the stroboscopic "
                             "section t = t_s + kT: the trajectory starts there (move it off "
                             "events that fall on t = kT, e.g. to continue through a fold)")]
+U0Opt = Annotated[Optional[str], typer.Option(
+    "--u0", show_default=False,
+    help="initial state of any components, NAME=VALUE,... in the model's state names (e.g. "
+         "X=0.1,Y=-0.2 for impact_2dof; the others start at 0), instead of --x0/--v0")]
+ShowOpt = Annotated[Optional[str], typer.Option(
+    "--show", show_default=False,
+    help="the two state components the figure shows, A,B (e.g. X,Y for impact_2dof); default: "
+         "the first two (X, V)")]
 WorkersOpt = Annotated[Optional[int], typer.Option("--workers", "-j", help="threads (default: all cores)")]
 DaskOpt = Annotated[Optional[str], typer.Option(
     "--dask", show_default=False,

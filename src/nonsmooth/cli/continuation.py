@@ -11,7 +11,7 @@ import typer
 from ..errors import ParameterError
 from .analyses import V0Opt, X0Opt
 from .app import app
-from .common import (DEFAULT_MODEL, SectionPhaseOpt, AtolOpt, ModelOpt, OutOpt, PlotOpt, PresetOpt, RtolOpt, SetOpt,
+from .common import (U0Opt, DEFAULT_MODEL, SectionPhaseOpt, AtolOpt, ModelOpt, OutOpt, PlotOpt, PresetOpt, RtolOpt, SetOpt,
                      check_outputs, echo_written, load_params, preset_label, resolve_method,
                      save_outputs)
 from .stability import OrbitMethodOpt, _num, print_table
@@ -48,6 +48,7 @@ def continue_cmd(
     k: Annotated[int, typer.Option("--k", help="period of the orbits in forcing periods")] = 1,
     x0: X0Opt = 0.0,
     v0: V0Opt = 0.0,
+    u0: U0Opt = None,
     transient: Annotated[int, typer.Option(
         "--transient", help="forcing periods run from (x0, v0) before the first orbit's "
                             "Newton search")] = 0,
@@ -113,9 +114,10 @@ def continue_cmd(
                              f"{param} = {lam0:g} (set it with --set {param}=VALUE)")
     if two_param is not None:
         return _two_parameter(params, preset, param, two_param, values, special, k, x0, v0,
-                              step, bounds, max_points, method, tol, out, plot, section_phase)
+                              step, bounds, max_points, method, tol, out, plot, section_phase,
+                              u0)
     check_outputs(out, plot)
-    ds = continuation(params, param, k=k, x0=x0, v0=v0, transient=transient,
+    ds = continuation(params, param, k=k, x0=x0, v0=v0, u0=u0, transient=transient,
                       direction=direction, step=step, max_step=max_step, bounds=bounds,
                       max_points=max_points, method=method, tol=tol, rtol=rtol, atol=atol,
                       section_phase=section_phase)
@@ -144,7 +146,7 @@ def continue_cmd(
 
 
 def _two_parameter(params, preset, param, param2, values, special, k, x0, v0, step, bounds,
-                   max_points, method, tol, out, plot, section_phase=0.0):
+                   max_points, method, tol, out, plot, section_phase=0.0, u0=None):
     """``nonsmooth continue --two-param``: the curve of --special points in (param, param2)."""
     import numpy as np
 
@@ -158,6 +160,7 @@ def _two_parameter(params, preset, param, param2, values, special, k, x0, v0, st
     grid = value_range(values[0], values[1], values[2], f"{param2} values", field="values")
     check_outputs(out, plot)
     ds = two_parameter_curve(params, param, param2, grid, special=special, k=k, x0=x0, v0=v0,
+                             u0=u0,
                              bounds=bounds, step=step, max_points=max_points, method=method,
                              tol=tol, section_phase=section_phase)
     save_outputs(ds, preset, out, plot, plot_two_parameter)

@@ -9,7 +9,7 @@ import typer
 
 from .analyses import SettleOpt, TransientOpt, X0Opt, V0Opt, _progress
 from .app import app
-from .common import (DEFAULT_MODEL, SectionPhaseOpt, AtolOpt, DaskOpt, MethodOpt, ModelOpt, OutOpt, PlotOpt, PresetOpt,
+from .common import (U0Opt, DEFAULT_MODEL, SectionPhaseOpt, AtolOpt, DaskOpt, MethodOpt, ModelOpt, OutOpt, PlotOpt, PresetOpt,
                      RtolOpt, SetOpt, WorkersOpt, check_outputs, chunk_store,
                      echo_written, load_params, preset_label, require_output, resolve_method,
                      save_outputs)
@@ -35,6 +35,7 @@ def map_cmd(
     record: Annotated[int, typer.Option("--record", help="section points recorded per point")] = 100,
     x0: X0Opt = 0.0,
     v0: V0Opt = 0.0,
+    u0: U0Opt = None,
     method: MethodOpt = None,
     rtol: RtolOpt = 1e-8,
     atol: AtolOpt = 1e-10,
@@ -74,7 +75,7 @@ def map_cmd(
     store, engine = chunk_store(out, dask)
     with _progress(f"map {x[0]} x {y[0]}") as prog:
         ds = parameter_map(params, x=x, y=tuple(y), transient=transient, record=record,
-                           method=method, start=start, x0=x0, v0=v0, rtol=rtol, atol=atol, section_phase=section_phase,
+                           method=method, start=start, x0=x0, v0=v0, u0=u0, rtol=rtol, atol=atol, section_phase=section_phase,
                            settle=settle, lyapunov=lyapunov,
                            workers=workers, progress=prog, store=store, engine=engine,
                            chunk=chunk)

@@ -7,7 +7,7 @@ from typing import Annotated, Optional
 import typer
 
 from .app import app
-from .common import (DEFAULT_MODEL, SectionPhaseOpt, AtolOpt, MethodOpt, ModelOpt, OutOpt, PlotOpt, PresetOpt, RtolOpt, SetOpt,
+from .common import (ShowOpt, U0Opt, DEFAULT_MODEL, SectionPhaseOpt, AtolOpt, MethodOpt, ModelOpt, OutOpt, PlotOpt, PresetOpt, RtolOpt, SetOpt,
                      check_outputs, echo_written, load_params, preset_label,
                      require_output, resolve_method, save_outputs)
 
@@ -24,29 +24,34 @@ def simulate_cmd(
         show_default=False)] = None,
     x0: Annotated[float, typer.Option(help="initial X")] = 0.0,
     v0: Annotated[float, typer.Option(help="initial V")] = 0.0,
+    u0: U0Opt = None,
     method: MethodOpt = None,
     rtol: RtolOpt = 1e-8,
     atol: AtolOpt = 1e-10,
     section_phase: SectionPhaseOpt = 0.0,
+    show: ShowOpt = None,
     out: OutOpt = None,
     plot: PlotOpt = None,
 ):
-    """Integrate one trajectory; save X, V, region over time (netCDF) and a Fig. 3-style plot."""
+    """Integrate one trajectory; save every state component and the region over time (netCDF)
+    and a Fig. 3-style plot."""
     from ..simulate import simulate
 
     params = load_params(preset, set_, model, "table1", method=method)
     method = resolve_method(params, method)
     preset = preset_label(params, preset, "table1")
+    from ..plot.common import check_show
+    pair = check_show(show, params.model.state_names)
     require_output(out, plot)
     check_outputs(out, plot)
     from ..simulate import mask_names
     from .analyses import _progress
     spp = {} if samples_per_period is None else {"samples_per_period": samples_per_period}
     with _progress("simulate") as prog:
-        ds = simulate(params, periods=periods, transient=transient, x0=x0, v0=v0, method=method,
+        ds = simulate(params, periods=periods, transient=transient, x0=x0, v0=v0, u0=u0, method=method,
                       rtol=rtol, atol=atol, section_phase=section_phase, progress=prog, **spp)
     from ..plot.time_response import plot_time_response
-    save_outputs(ds, preset, out, plot, plot_time_response)
+    save_outputs(ds, preset, out, plot, lambda d: plot_time_response(d, show=pair))
     typer.echo(f"{preset}: {periods} periods after {transient}, max X = {float(ds.max_X):.6g}, "
                f"min X = {float(ds.min_X):.6g}, {params.model.mode_word} visited: "
                f"{', '.join(mask_names(ds.regions_visited))}")

@@ -10,7 +10,7 @@ import typer
 
 from .analyses import TransientOpt, V0Opt, X0Opt, _progress
 from .app import app
-from .common import (DEFAULT_MODEL, SectionPhaseOpt, AtolOpt, MethodOpt, ModelOpt, OutOpt, PlotOpt, PresetOpt, RtolOpt, SetOpt,
+from .common import (U0Opt, DEFAULT_MODEL, SectionPhaseOpt, AtolOpt, MethodOpt, ModelOpt, OutOpt, PlotOpt, PresetOpt, RtolOpt, SetOpt,
                      check_outputs, echo_written, load_params, preset_label, resolve_method,
                      save_outputs)
 
@@ -62,6 +62,7 @@ def lyapunov_cmd(
     transient: TransientOpt = 1000,
     x0: X0Opt = 0.0,
     v0: V0Opt = 0.0,
+    u0: U0Opt = None,
     blocks: Annotated[int, typer.Option(
         "--blocks", help="block means for the standard errors (>= 2)")] = 20,
     method: MethodOpt = None,
@@ -85,7 +86,7 @@ def lyapunov_cmd(
     check_int("blocks", blocks, 2)
     check_outputs(out, plot)
     with _progress("lyapunov") as prog:
-        ds = lyapunov(params, periods=periods, transient=transient, x0=x0, v0=v0,
+        ds = lyapunov(params, periods=periods, transient=transient, x0=x0, v0=v0, u0=u0,
                       method=method, rtol=rtol, atol=atol, section_phase=section_phase, blocks=blocks, progress=prog)
     from ..plot.stability import plot_lyapunov
     save_outputs(ds, preset, out, plot, plot_lyapunov)
@@ -110,6 +111,7 @@ def orbit_cmd(
     k: Annotated[int, typer.Option("--k", help="period of the orbit in forcing periods")] = 1,
     x0: X0Opt = 0.0,
     v0: V0Opt = 0.0,
+    u0: U0Opt = None,
     transient: Annotated[int, typer.Option(
         "--transient", help="forcing periods run from (x0, v0) before Newton starts")] = 0,
     tol: Annotated[float, typer.Option(
@@ -137,22 +139,27 @@ def orbit_cmd(
     check_int("transient", transient, 0)
     check_int("max_iter", max_iter, 1)
     check_outputs(out, plot)
-    ds = periodic_orbit(params, k=k, x0=x0, v0=v0, method=method, transient=transient,
+    ds = periodic_orbit(params, k=k, x0=x0, v0=v0, u0=u0, method=method, transient=transient,
                         tol=tol, max_iter=max_iter, rtol=rtol, atol=atol,
                       section_phase=section_phase)
     a = ds.attrs
     if a["status"] != "converged":
-        typer.echo(f"error: orbit: no period-{k} orbit found from (x0, v0) = ({x0:g}, {v0:g}): "
+        names = params.model.state_names
+        start = (f"(x0, v0) = ({x0:g}, {v0:g})" if u0 is None else
+                 ", ".join(f"{nm}={float(x):g}" for nm, x in zip(names, a["u0"])))
+        typer.echo(f"error: orbit: no period-{k} orbit found from {start}: "
                    f"{a['status']} after {a['iterations']} iterations (residual "
-                   f"{a['residual']:.3g}); try another start (--x0, --v0), --transient or "
-                   f"--max-iter", err=True)
+                   f"{a['residual']:.3g}); try another start (--x0, --v0 or --u0), --transient "
+                   f"or --max-iter", err=True)
         raise typer.Exit(EXIT_NOT_FOUND)
+    from ..io import components
     from ..plot.stability import multiplier_value, plot_orbit
     save_outputs(ds, preset, out, plot, plot_orbit)
     typer.echo(f"{preset} ({method}): period-{k} orbit converged in {a['iterations']} "
                f"iterations (residual {a['residual']:.3g})")
-    print_table(("point", "X(jT)", "V(jT)"),
-                [(str(j), _num(float(ds.X_section[j])), _num(float(ds.V_section[j])))
+    print_table(("point",) + tuple(f"{nm}(jT)" for nm in params.model.state_names),
+                [(str(j),) + tuple(_num(float(x))
+                                   for x in components(ds, suffix="_section").values[j])
                  for j in range(ds.sizes["point"])])
     print_table(("multiplier", "mu", "|mu|"),
                 [(str(j + 1), multiplier_value(ds, j, 6), f"{float(ds.multiplier_abs[j]):.6g}")

@@ -134,13 +134,15 @@ def _signatures():
 
     f8 = t.float64[:]  # any layout: the kernels touch these arrays once per call or interval
     args = (f8, f8, f8, t.int64, t.int64, t.int64, f8, f8, t.int8[:], t.uint8[:], f8, f8)
-    tangent = (t.float64[:, ::1], t.float64[:, ::1], t.int64[::1], t.int64)
+    tangent = (t.float64[:, ::1], t.float64[:, ::1], t.int64[::1], t.int64, t.float64[:, ::1],
+               t.float64[::1], t.float64[::1], t.float64[:, ::1], t.float64[::1])
     return (t.int64(*args), t.int64(MODEL_FNS_TYPE, *args),
             t.int64(t.int64, MODEL_FNS_TYPE, *args), t.int64(MODEL_FNS_TYPE, *args, *tangent))
 
 
 #: Explicit numba signatures of a kernel, of the method dispatcher and of the tangent kernel
-#: (``hybrid.advance_tangent``: the generic kernel's arguments, then Y, L_out, cmi, qr).
+#: (``hybrid.advance_tangent``: the generic kernel's arguments, then Y, L_out, cmi, qr, U_out,
+#: H, SEC, U_sec, T_sec).
 #: Compiling the kernels for exactly these types means one machine-code version each: without
 #: them numba would compile (and cache) a new copy of every kernel for each combination of
 #: literal integers that a caller happens to pass.

@@ -690,9 +690,12 @@ def _qr_logs(Y, out, row):
 
 @nb.njit(cache=True, fastmath=_FM)
 def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out, M_out,
-             Xmax_out, Xmin_out, Y, L_out, cmi, qr):
+             Xmax_out, Xmin_out, Y, L_out, cmi, qr, U_out, H, SEC, U_sec, T_sec):
     field, jacobian, guards, transition, initial, linear = fns
     tan = Y.shape[1] > 0
+    # a section surface h = H . (u, 1, cos, sin) = 0 (``advance_tangent``): an extra guard row
+    # whose crossings are recorded, never a transition (its sign flips at each crossing)
+    has_sec = H.shape[0] > 0
     n = int(opts[OPT_N])
     nmem = int(opts[OPT_NMEM])
     if n < 2 or nmem < 0 or n - 2 + nmem > N_STATE - ST_EXTRA:
@@ -804,6 +807,26 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
         keep_alive(ws)
         return st.EVENT_FAILED
     ng = min(max(guards(mode, pp, mem, G), 0), MAX_GUARDS)
+    sgn = 1.0  # orientation of the section row: g = sgn h >= 0 on the side the state is on
+    ksec = -1
+    n_sec = 0
+    t_done = 0.0  # time of the periods this call has completed
+    if has_sec:
+        if ng >= MAX_GUARDS:
+            _store(state, u, n, mem, nmem, mode, h)
+            keep_alive(ws)
+            return st.EVENT_FAILED
+        for i in range(n + 3):
+            G[ng, i] = H[i]
+        f_dummy = f0  # h and h' at the start: on the surface, the side it moves to
+        field(mode, t0, C0, S0, u, pp, mem, f_dummy)
+        h0 = _gval(G, ng, n, u, C0, S0)
+        if h0 < 0.0 or (h0 == 0.0 and _dgval(G, ng, n, f_dummy, C0, S0, om) < 0.0):
+            sgn = -1.0
+        for i in range(n + 3):
+            G[ng, i] = sgn * H[i]
+        ksec = ng
+        ng += 1
     cls = _mode_class(linear, closed, mode, pp, lin, MC, mcs, om, MF)
     if cls == _MC_RESONANT:
         _store(state, u, n, mem, nmem, mode, h)
@@ -1013,6 +1036,23 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
                 tau = t_end if last else tau + hs
                 xmax = max(xmax, u[0])
                 xmin = min(xmin, u[0])
+            if k_tr >= 0 and k_tr == ksec:
+                # ---- a crossing of the section surface: record it, flip the row ----
+                if SEC[0] == 0.0 or SEC[0] == -sgn:
+                    if n_sec < U_sec.shape[0]:
+                        for i in range(n):
+                            U_sec[n_sec, i] = u[i]
+                        T_sec[n_sec] = t_done + (tau - t0)
+                    n_sec += 1
+                sgn = -sgn
+                for i in range(n + 3):
+                    G[ksec, i] = -G[ksec, i]
+                if cf:
+                    _cf_bounds(MC, mode, om, G, ng, n, GB)
+                if SEC[1] > 0.0 and n_sec >= SEC[1]:
+                    SEC[3] = t_done + (tau - t0)
+                    break
+                continue
             if k_tr >= 0:
                 # ---- transition through guard k_tr at (tau, u) ----
                 gdot = 0.0
@@ -1040,6 +1080,14 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
                 mode = new_mode
                 mask |= 1 << mode
                 ng = min(max(guards(mode, pp, mem, G), 0), MAX_GUARDS)
+                if has_sec:
+                    if ng >= MAX_GUARDS:
+                        code = st.EVENT_FAILED
+                        break
+                    for i in range(n + 3):
+                        G[ng, i] = sgn * H[i]
+                    ksec = ng
+                    ng += 1
                 cls = _mode_class(linear, closed, mode, pp, lin, MC, mcs, om, MF)
                 if cls == _MC_RESONANT:
                     code = st.RESONANCE
@@ -1064,8 +1112,11 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
                 xmin = min(xmin, u[0])
         if code != st.OK:
             break
+        if has_sec and SEC[1] > 0.0 and n_sec >= SEC[1]:
+            break  # stopped on the section (the outputs of this interval are not written)
         if j == per_period:
             j = 0
+            t_done += T
             tau = t0
             t_switch -= T
             C = C0
@@ -1076,6 +1127,13 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
                 _qr_logs(Y, L_out, it - n_skip)
         record_interval(it, n_skip, u[0], u[1], mode, mask, xmax, xmin, X_out, V_out, R_out,
                         M_out, Xmax_out, Xmin_out)
+        if U_out.shape[0] > 0 and it >= n_skip:
+            for i in range(n):
+                U_out[it - n_skip, i] = u[i]
+    if has_sec:
+        SEC[2] = n_sec
+        if not (SEC[1] > 0.0 and n_sec >= SEC[1]):
+            SEC[3] = t_done + (tau - t0)
     _store(state, u, n, mem, nmem, mode, h)
     keep_alive(ws)  # the views above are not used after this
     return code
@@ -1087,12 +1145,13 @@ def advance_generic(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out
     """Kernel contract (see ``integrate.contract``) for a hybrid model given by ``fns``."""
     return _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out, M_out,
                     Xmax_out, Xmin_out, np.zeros((0, 0)), np.zeros((0, 0)),
-                    np.zeros(0, np.int64), 0)
+                    np.zeros(0, np.int64), 0, np.zeros((0, 0)), np.zeros(0), np.zeros(4),
+                    np.zeros((0, 0)), np.zeros(0))
 
 
 @nb.njit(TANGENT_KERNEL_SIGNATURE, cache=True, fastmath=_FM)
 def advance_tangent(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out, M_out,
-                    Xmax_out, Xmin_out, Y, L_out, cmi, qr):
+                    Xmax_out, Xmin_out, Y, L_out, cmi, qr, U_out, H, SEC, U_sec, T_sec):
     """``advance_generic`` that also carries tangent vectors (the columns of Y) along the
     trajectory: the variational equation of each mode (``_rk_tangent`` / ``_cf_tangent``) and
     the saltation matrix of every transition (``_saltation``). Rows of Y: the state u (n), then
@@ -1100,9 +1159,24 @@ def advance_tangent(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out
     columns are re-orthonormalised at every forcing-period end (Benettin) and the logs of the
     norms of the recorded periods go to ``L_out[period - n_skip]`` (per_period must be 1);
     with ``qr`` = 0, Y is left as the product (the monodromy of the stroboscopic map when
-    Y starts as the identity)."""
+    Y starts as the identity). ``U_out`` (n_out x n, or 0 x 0 for none) receives every
+    component of the state u at each output; Y with no columns carries nothing (the plain
+    kernel, with all components recorded).
+
+    A section surface ``H`` (n + 3: h = H . (u, 1, cos omega t, sin omega t); empty: none):
+    its crossings are located like a guard's and recorded, in the direction ``SEC[0]`` (-1: h
+    decreasing, +1: increasing, 0: both), as U_sec[i] (the state) and T_sec[i] (the time since
+    the call began), at most len(T_sec) of them; ``SEC[2]`` returns their number. With
+    ``SEC[1]`` = m > 0 the call stops at the m-th recorded crossing (mid-period: for an
+    autonomous system, whose field does not depend on t), Y and ``state`` then hold the
+    crossing, and ``SEC[3]`` the time since the call began (else the time integrated). A state
+    on the surface at the start is not a crossing."""
     if Y.shape[0] != int(opts[OPT_N]) + len(cmi) or (qr == 1 and (
-            per_period != 1 or L_out.shape[0] < n_out or L_out.shape[1] < Y.shape[1])):
+            per_period != 1 or L_out.shape[0] < n_out or L_out.shape[1] < Y.shape[1])) or (
+            U_out.shape[0] > 0 and (U_out.shape[0] < n_out or U_out.shape[1] < int(opts[OPT_N]))) or (
+            H.shape[0] > 0 and (H.shape[0] != int(opts[OPT_N]) + 3 or SEC.shape[0] < 4
+                                or U_sec.shape[0] != T_sec.shape[0] or (
+                                    U_sec.shape[0] > 0 and U_sec.shape[1] < int(opts[OPT_N])))):
         return st.NON_FINITE
     return _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out, M_out,
-                    Xmax_out, Xmin_out, Y, L_out, cmi, qr)
+                    Xmax_out, Xmin_out, Y, L_out, cmi, qr, U_out, H, SEC, U_sec, T_sec)

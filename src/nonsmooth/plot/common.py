@@ -72,6 +72,38 @@ def state_labels(ds) -> tuple:
     return tuple(m.axis_labels) or tuple(f"${n}$" for n in m.state_names)
 
 
+def check_show(show, names) -> tuple | None:
+    """``show`` (None, "X,Y" or a pair of component names) as a pair of names among ``names``
+    (the model's ``state_names``); a one-line ParameterError naming ``show`` otherwise."""
+    from ..errors import ParameterError
+    if show is None:
+        return None
+    parts = [t.strip() for t in show.split(",")] if isinstance(show, str) else list(show)
+    if len(parts) != 2:
+        raise ParameterError(f"show: expected two state components (e.g. X,V), got {show!r}")
+    for name in parts:
+        if name not in names:
+            raise ParameterError(f"show: unknown component {name!r} (the model has "
+                                 f"{', '.join(names)})")
+    return tuple(parts)
+
+
+def shown_components(ds, show, prefix: str = ""):
+    """The two state components a figure shows: ``show`` (None: the first two), as
+    (index a, index b, label a, label b, values of a, values of b) from the dataset's
+    component variables (``<prefix>X``, ``<prefix>V``, then one per further component, see
+    ``io.components``); indices into the model's states."""
+    from ..io import component_names
+    labels = state_labels(ds)
+    names = str(ds.attrs.get("state_names", "X V")).split()
+    pair = check_show(show, names) or tuple(names[:2])
+    a, b = names.index(pair[0]), names.index(pair[1])
+    var = [f"{prefix}{nm}" for nm in component_names(names)]
+    la = labels[a] if a < len(labels) else f"${names[a]}$"
+    lb = labels[b] if b < len(labels) else f"${names[b]}$"
+    return a, b, la, lb, ds[var[a]].values, ds[var[b]].values
+
+
 def param_symbol(m, name: str) -> str:
     """The plot symbol (mathtext) of parameter ``name`` of model ``m`` (the name if none)."""
     if m is not None:

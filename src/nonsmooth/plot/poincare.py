@@ -4,7 +4,7 @@ from __future__ import annotations
 
 
 from .common import (draw_model_lines, model_of, new_figure, param_title, scatter_by_region,
-                     state_labels)
+                     shown_components)
 
 
 def _period_text(ds) -> str:
@@ -15,28 +15,32 @@ def _period_text(ds) -> str:
     return f"{kind}, {contact}"
 
 
-def plot_poincare(ds):
+def plot_poincare(ds, show=None):
     """Left: phase portrait V(X) over the orbit run (coloured by the model's modes) with the
     section points on it and the model's lines of X (support: X = 1); right: the Poincaré map
-    (all section points, small dots)."""
+    (all section points, small dots). ``show`` = (a, b), two state component names (or
+    "a,b"): both panels in the plane (a, b) instead."""
     fig, (ax0, ax1) = new_figure(1, 2, figsize=(11, 4.6))
-    oX, oV, oR = ds.orbit_X.values, ds.orbit_V.values, ds.orbit_region.values
-    X, V = ds.X.values, ds.V.values
+    ia, ib, la, lb, oX, oV = shown_components(ds, show, "orbit_")
+    X, V = shown_components(ds, show)[4:]
+    oR = ds.orbit_region.values
     ax0.plot(oX, oV, color="0.55", lw=0.6, zorder=1)
     scatter_by_region(ax0, oX, oV, oR, s=1.5, model=model_of(ds), zorder=2)
     few = X.size <= 64 or int(ds["period"]) > 0
     ax0.scatter(X, V, s=16 if few else 1.0, color="k",
                 marker="o", zorder=3, linewidths=0,
                 label=r"section $t = kT$")
-    draw_model_lines(ax0, ds, "v", label=False, band_edges=False)
-    ax0.set_xlabel(state_labels(ds)[0])
-    ax0.set_ylabel(state_labels(ds)[1])
+    if ia == 0:
+        draw_model_lines(ax0, ds, "v", label=False, band_edges=False)
+    ax0.set_xlabel(la)
+    ax0.set_ylabel(lb)
     ax0.set_title(f"(a) phase portrait: {_period_text(ds)}", fontsize=10)
     ax0.legend(loc="lower left", fontsize=7, markerscale=2)
     n = X.size
     ax1.scatter(X, V, s=25.0 if few else (1.0 if n > 500 else 6.0), color="k", linewidths=0)
-    ax1.set_xlabel(r"$X(kT)$")
-    ax1.set_ylabel(r"$V(kT)$")
+    names = str(ds.attrs.get("state_names", "X V")).split()
+    ax1.set_xlabel(r"$X(kT)$" if ia == 0 else f"${names[ia]}(kT)$")
+    ax1.set_ylabel(r"$V(kT)$" if ib == 1 else f"${names[ib]}(kT)$")
     ax1.set_title(f"(b) Poincaré map, {n} points after {ds.attrs.get('transient', '?')} periods",
                   fontsize=10)
     for ax in (ax0, ax1):

@@ -4,9 +4,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from .common import (draw_model_lines, draw_phase_lines, has_support_bands, mode_colors, state_labels,
+from .common import (draw_model_lines, draw_phase_lines, has_support_bands, mode_colors,
                      mode_labels, model_lines, model_of, new_figure, param_title,
-                     scatter_by_region)
+                     scatter_by_region, shown_components)
 
 
 def _crossed_between_samples(ax, x, y, R, M, model):
@@ -24,31 +24,36 @@ def _crossed_between_samples(ax, x, y, R, M, model):
                        label=f"{labels[code]} crossed between samples")
 
 
-def plot_time_response(ds):
-    """Figure with X(t) (left) and the phase portrait V(X) (right), coloured by the model's
+def plot_time_response(ds, show=None):
+    """Figure with X(t) (left) and the phase portrait V(X) (middle), coloured by the model's
     modes, with the model's lines of X drawn (support, smooth method: the band edges
-    h_alpha = +-eta and h_beta = +-eta) and a zoom on the switching zone (around the model's
-    first line). Modes visited only between two samples (``visited`` mask) are marked with
-    rings, so the figure shows every mode the trajectory visited."""
+    h_alpha = +-eta and h_beta = +-eta) and a zoom on the switching zone (right: around the
+    model's first line, in the (X, V) plane). Modes visited only between two samples
+    (``visited`` mask) are marked with rings, so the figure shows every mode the trajectory
+    visited. ``show`` = (a, b), two state component names (or "a,b"): the left panel shows
+    a(t) and the middle one b(a) instead (a model with more than two components)."""
     fig, axes = new_figure(1, 3, figsize=(15, 4.5), gridspec_kw={"width_ratios": [1.4, 1, 1]})
     t, X, V, R = ds.t.values, ds.X.values, ds.V.values, ds.region.values
     M = ds.visited.values
     model = model_of(ds)
     eta = float(ds.attrs.get("param_eta", 0.0)) if has_support_bands(ds) else 0.0
     lines = model_lines(ds, band_edges=False)
+    ia, ib, la, lb, A, B = shown_components(ds, show)
     ax = axes[0]
-    ax.plot(t, X, color="0.8", lw=0.8, zorder=0)
-    scatter_by_region(ax, t, X, R, s=4, model=model)
-    _crossed_between_samples(ax, t, X, R, M, model)
-    draw_model_lines(ax, ds, "h", label=False, band_edges=False)
+    ax.plot(t, A, color="0.8", lw=0.8, zorder=0)
+    scatter_by_region(ax, t, A, R, s=4, model=model)
+    _crossed_between_samples(ax, t, A, R, M, model)
+    if ia == 0:
+        draw_model_lines(ax, ds, "h", label=False, band_edges=False)
     ax.set_xlabel("t [s]")
-    ax.set_ylabel(state_labels(ds)[0])
+    ax.set_ylabel(la)
     ax.set_title("time response")
     ax.legend(loc="upper right", markerscale=3, fontsize=8)
     for ax, zoom in ((axes[1], False), (axes[2], True)):
-        ax.plot(X, V, color="0.8", lw=0.8, zorder=0)
-        scatter_by_region(ax, X, V, R, s=4, legend=False, model=model)
-        _crossed_between_samples(ax, X, V, R, M, model)
+        x, y = (X, V) if zoom else (A, B)
+        ax.plot(x, y, color="0.8", lw=0.8, zorder=0)
+        scatter_by_region(ax, x, y, R, s=4, legend=False, model=model)
+        _crossed_between_samples(ax, x, y, R, M, model)
         if zoom:
             x1 = lines[0][0] if lines else None
             w = max(20 * eta, 0.02)
@@ -61,9 +66,10 @@ def plot_time_response(ds):
             ax.set_title("zoom on the switching bands")
         else:
             ax.set_title("phase portrait")
-        draw_phase_lines(ax, ds, label=not zoom)
-        ax.set_xlabel("X")
-        ax.set_ylabel("V = dX/dt")
+        if zoom or ia == 0:
+            draw_phase_lines(ax, ds, label=not zoom)
+        ax.set_xlabel("X" if zoom else la)
+        ax.set_ylabel("V = dX/dt" if zoom else lb)
     if axes[1].get_legend_handles_labels()[0]:
         axes[1].legend(loc="lower left", fontsize=8)
     fig.suptitle(f"{ds.attrs.get('method', '')}: {param_title(ds)}", fontsize=9)
