@@ -37,6 +37,11 @@ _LAZY = {
     "continuation": ".analysis.continuation",
     "two_parameter_curve": ".analysis.continuation",
     "parameter_map": ".analysis.parameter_map",
+    "surface_section": ".analysis.autonomous",
+    "limit_cycle": ".analysis.autonomous",
+    "equilibria": ".analysis.autonomous",
+    "equilibrium_branch": ".analysis.autonomous",
+    "limit_cycle_branch": ".analysis.autonomous",
     "reproduce": ".reproduction",
 }
 
@@ -46,6 +51,8 @@ _SUBMODULES = ("analysis", "cli", "errors", "integrate", "io", "kernels", "model
 
 __all__ = ["__version__", "Params", "PARAM_NAMES", "model", "models", "model_from_equations", "Guard", "preset", "PRESETS", "simulate", "reproduce", "Solver",
            "eta_study", "lyapunov", "periodic_orbit", "continuation", "two_parameter_curve", "parameter_map", "poincare", "bifurcation_diagram", "resonance_curve", "basins",
+           "surface_section", "limit_cycle", "equilibria", "equilibrium_branch",
+           "limit_cycle_branch",
            "NonsmoothError", "ParameterError", "OutputError", "IntegrationError"]
 
 

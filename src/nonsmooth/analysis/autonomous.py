@@ -1,0 +1,699 @@
+"""Self-excited (autonomous) systems: Poincaré sections on a surface, limit cycles with their
+period as an unknown, equilibria with their eigenvalues, and the Hopf points of equilibria along
+a parameter (issue 23, item 3).
+
+A system is autonomous when its field does not depend on time: a model whose forcing amplitude
+(``Model.forcing_amplitude``, e.g. ``F0``) is 0, or a model without forcing terms. Its forcing
+frequency then only sets the kernel's time unit T = 2 pi / omega (step budgets, output
+intervals), never a number of the results.
+
+* **Section surface** h(u) = a . u + b = 0, crossed in a direction (``"decreasing"``: h from
+  positive to negative, the default; ``"increasing"``; ``"both"``): given as an expression affine
+  in the state, with the model's parameters allowed (``"V"``, ``"X - delta"``,
+  ``("V - v_belt", "increasing")``). Crossings are located by the kernel like switching events
+  (``hybrid.advance_tangent`` with a section row), to the kernel's event tolerance.
+* **Return map** P: a point z on the section to the next crossing in the direction; its time is
+  the return time. Its Jacobian from the flow's tangent Phi (saltation matrices at the
+  switches included) and the field f at the crossing: dP = (I - f a^T / (a . f)) Phi.
+* **Limit cycle** (:func:`limit_cycle`): Newton's method for P(z) = z on the section's
+  coordinates (an orthonormal basis B of a^perp): (B^T dP B - I) dw = -B^T (P(z) - z); the
+  period is the return time. The Floquet multipliers are the eigenvalues of B^T dP B, the
+  n - 1 nontrivial ones (the trivial multiplier 1, along the flow, is removed).
+* **Equilibria** (:func:`equilibria`): Newton on f(mode, u) = 0 in every mode of the method,
+  from given starts (or a default set), kept where the mode holds (its guards >= 0 there);
+  eigenvalues of the mode's Jacobian, stable when every real part is < 0.
+* **Hopf points** (:func:`equilibrium_branch`): an equilibrium followed along a parameter
+  (Newton from the previous value), its eigenvalues at each value, and the values where a
+  complex pair crosses the imaginary axis, located by the secant / Illinois method to 1e-10.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import xarray as xr
+
+from .. import status as st
+from ..errors import IntegrationError, ParameterError
+from ..integrate.contract import ST_MODE
+from ..io import provenance_attrs
+from ..kernels import Solver, output_buffers
+from ..models.base import KERNEL_GENERIC
+
+#: Crossing directions by name and code (the kernel's SEC[0]).
+DIRECTIONS = {"decreasing": -1.0, "increasing": 1.0, "both": 0.0}
+#: Newton's tolerance on |P(z) - z| / (1 + |z|) and the largest residual a converged cycle
+#: may show when integrated again (confirmation).
+CONFIRM_TOL = 1e-7
+
+
+# ---- the section surface --------------------------------------------------------------------
+def parse_section(params, section):
+    """(H, direction code, text) of a section given as an expression, or (expression,
+    direction): H = (a, b, 0, 0) with h = a . u + b. One-line ParameterErrors name
+    ``section``."""
+    import sympy as sp
+
+    model = params.model
+    direction = "decreasing"
+    if isinstance(section, (tuple, list)):
+        if len(section) != 2:
+            raise ParameterError(f"section: expected an expression or (expression, direction), "
+                                 f"got {section!r}")
+        section, direction = section
+    if direction not in DIRECTIONS:
+        raise ParameterError(f"section: direction must be one of {', '.join(DIRECTIONS)}, got "
+                             f"{direction!r}")
+    if not isinstance(section, str) or not section.strip():
+        raise ParameterError(f"section: expected an expression in the state "
+                             f"({', '.join(model.state_names)}), got {section!r}")
+    states = [sp.Symbol(nm, real=True) for nm in model.state_names]
+    names = {nm: s for nm, s in zip(model.state_names, states)}
+    names.update({nm: sp.Symbol(nm, real=True) for nm in model.param_names})
+    import re
+    unknown = sorted({w for w in re.findall(r"[A-Za-z_]\w*", section)} - set(names)
+                     - {"sin", "cos", "exp", "log", "sqrt", "pi", "Abs"})
+    if unknown:
+        raise ParameterError(f"section: unknown name(s) {', '.join(unknown)} in {section!r} "
+                             f"(state: {', '.join(model.state_names)}; parameters allowed)")
+    try:
+        expr = sp.sympify(section, locals=names)
+    except (sp.SympifyError, SyntaxError, TypeError) as exc:
+        raise ParameterError(f"section: cannot read {section!r} "
+                             f"({type(exc).__name__})") from None
+    unknown = {str(s) for s in expr.free_symbols} - set(names)
+    if unknown:
+        raise ParameterError(f"section: unknown name(s) {', '.join(sorted(unknown))} in "
+                             f"{section!r} (state: {', '.join(model.state_names)}; parameters "
+                             f"allowed)")
+    expr = expr.subs({names[nm]: float(getattr(params, nm)) for nm in model.param_names})
+    coeffs = [sp.diff(expr, s) for s in states]
+    if any(sp.simplify(sp.diff(c, s)) != 0 for c in coeffs for s in states):
+        raise ParameterError(f"section: {section!r} is not affine in the state (curved "
+                             f"sections are not supported yet)")
+    try:
+        a = np.array([float(c) for c in coeffs])
+        b = float(expr.subs({s: 0 for s in states}))
+    except TypeError:
+        raise ParameterError(f"section: {section!r} is not affine in the state") from None
+    if not np.any(a != 0.0) or not np.all(np.isfinite(a)) or not math.isfinite(b):
+        raise ParameterError(f"section: {section!r} does not depend on the state")
+    H = np.concatenate([a, [b, 0.0, 0.0]])
+    return H, DIRECTIONS[direction], f"{section} = 0, {direction}"
+
+
+def check_autonomous(params, who: str) -> None:
+    """A one-line ParameterError if the model's forcing amplitude is not 0."""
+    fa = params.model.forcing_amplitude
+    if fa and fa in params.model.param_names and float(getattr(params, fa)) != 0.0:
+        raise ParameterError(f"{who}: the system is forced ({fa} = {getattr(params, fa):g}): "
+                             f"set {fa}=0 for a self-excited system, or use the stroboscopic "
+                             f"analyses (poincare, periodic_orbit)")
+
+
+class _Flow:
+    """The generic kernel with a section surface, from Python: crossings, the return map and
+    its Jacobian."""
+
+    def __init__(self, params, solver, H, direction, max_time):
+        from ..tangent import TangentSetup
+        self.setup = TangentSetup(solver)
+        self.model = params.model
+        self.p = params.pack()
+        self.H = H
+        self.a = H[:self.model.n]
+        self.direction = direction
+        self.T = params.period
+        self.budget = max(1, int(math.ceil(max_time / self.T)))
+        self.max_time = max_time
+
+    def crossings(self, state, m, record=0, tangent=False):
+        """Advance ``state`` (in place) to its m-th crossing; returns (status, time, U, T, Y):
+        the first ``record`` crossings' states and times, and the flow's Jacobian Phi (N x N)
+        when ``tangent``. Status "no crossing" when fewer than m come within max_time."""
+        n, N = self.setup.n, self.setup.N
+        SEC = np.array([self.direction, float(m), 0.0, 0.0])
+        U = np.empty((record, n))
+        Tc = np.empty(record)
+        Y = np.eye(N) if tangent else np.zeros((N, 0))
+        code, _ = self.setup.run(self.p, state, 0, Y, transient=self.budget,
+                                 section=(self.H, SEC, U, Tc))
+        if code != st.OK:
+            return f"integration failed: {st.message(code)}", math.nan, U, Tc, Y
+        if SEC[2] < m:
+            return (f"no crossing: {int(SEC[2])} of {m} crossings of the section within "
+                    f"{self.max_time:g} time units"), math.nan, U, Tc, Y
+        return "ok", float(SEC[3]), U, Tc, Y
+
+    def field(self, state):
+        """The field f at a kernel state (its mode)."""
+        from ..models._probe import call_field
+        from ..simulate import state_u
+        u = state_u(self.model, state)
+        du = np.zeros(self.model.n)
+        mem = np.zeros(max(1, self.model.n_memory))
+        call_field(self.setup.fns, int(state[ST_MODE]), 0.0, 1.0, 0.0, u, self.p, mem, du)
+        return du
+
+    def return_map(self, state):
+        """(status, state at the next crossing, return time, dP (n x n))."""
+        s = state.copy()
+        status, t, _, _, Y = self.crossings(s, 1, tangent=True)
+        if status != "ok":
+            return status, s, t, None
+        n = self.model.n
+        f = self.field(s)
+        af = float(self.a @ f)
+        if abs(af) <= 1e-12 * (np.linalg.norm(self.a) * np.linalg.norm(f) + 1e-300):
+            return "grazing the section (the flow is tangent to it)", s, t, None
+        Phi = Y[:n, :n]
+        dP = Phi - np.outer(f, self.a @ Phi) / af
+        return "ok", s, t, dP
+
+
+def _start(params, solver, x0, v0, u0):
+    from ..simulate import initial_u, state_from_u
+    from ..kernels import run
+    u = initial_u(params.model, x0, v0, u0)
+    s = state_from_u(u)
+    run(KERNEL_GENERIC, solver.fns, params.pack(), solver.opts(), s, 1, 0, 0,
+        *output_buffers(0))  # classify the mode without moving
+    return u, s
+
+
+def _setup(params, section, method, rtol, atol, max_time, who):
+    from ..simulate import check_float, check_params
+    params = check_params(params)
+    check_autonomous(params, who)
+    solver = Solver(method=method, rtol=rtol, atol=atol, model=params.model)
+    H, direction, text = parse_section(params, section)
+    max_time = check_float("max_time", max_time)
+    if not max_time > 0:
+        raise ParameterError(f"max_time: must be > 0, got {max_time}")
+    return params, solver, _Flow(params, solver, H, direction, max_time), text
+
+
+def _xv(model, dims, U, what: str, suffix: str = "") -> dict:
+    """Variables of the state U (last axis: components): X, V and one per further component
+    (``io.components`` assembles them)."""
+    from ..simulate import component_variables
+    units = tuple(model.state_units) + ("1",) * model.n
+    return {f"X{suffix}": (dims, U[..., 0], {"long_name": f"X{what}", "units": units[0]}),
+            f"V{suffix}": (dims, U[..., 1], {"long_name": f"V{what}", "units": units[1]}),
+            **component_variables(model, dims, U, suffix=suffix, what=what)}
+
+
+# ---- analyses -------------------------------------------------------------------------------
+def surface_section(params, section="V", *, crossings: int = 200, transient: int = 20,
+                    x0: float = 0.0, v0: float = 0.0, u0=None, method: str = "exact",
+                    rtol: float = 1e-10, atol: float = 1e-12,
+                    max_time: float = 1e4) -> xr.Dataset:
+    """Poincaré section of a self-excited system on a surface: from (x0, v0) (or ``u0``), skip
+    ``transient`` crossings, then record ``crossings`` crossings of ``section`` (see the module
+    docstring) in its direction. Returns a Dataset over ``crossing`` with the state (``X``,
+    ``V`` and one variable per further component, ``io.components(ds)``), the time ``t`` since the last transient crossing and the
+    ``return_time`` from the crossing before; scalars ``cycle_crossings`` (the smallest q <= 16
+    with u repeating after q crossings to 1e-6 (1 + |u|); 0: none), ``cycle_period`` (the
+    time of those q crossings; NaN: none) and ``at_equilibrium`` (the crossings converge onto
+    an equilibrium, a focus: no cycle). A surface the orbit stops crossing within
+    ``max_time`` (per call: the transient, then the record) raises a one-line
+    IntegrationError."""
+    from ..simulate import check_int, start_attrs
+    params, solver, flow, text = _setup(params, section, method, rtol, atol, max_time,
+                                        "surface_section")
+    crossings = check_int("crossings", crossings, 1)
+    transient = check_int("transient", transient, 0)
+    u_start, s = _start(params, solver, x0, v0, u0)
+    if transient:
+        status, _, _, _, _ = flow.crossings(s, transient)
+        if status != "ok":
+            raise IntegrationError(f"surface_section: transient: {status}")
+    status, _, U, Tc, _ = flow.crossings(s, crossings, record=crossings)
+    if status != "ok":
+        raise IntegrationError(f"surface_section: {status}")
+    ret = np.diff(np.concatenate([[0.0], Tc]))
+    q_found, period = 0, math.nan
+    scale = 1.0 + float(np.max(np.abs(U)))
+    # crossings that converge onto an equilibrium (a focus: the field vanishes there) repeat
+    # too, but are no cycle
+    at_rest = float(np.linalg.norm(flow.field(s))) <= 1e-6 * scale
+    for q in range(1, 0 if at_rest else min(16, crossings // 2) + 1):
+        if np.max(np.abs(U[q:] - U[:-q])) <= 1e-6 * scale:
+            q_found, period = q, float(np.mean([Tc[i + q] - Tc[i]
+                                                for i in range(crossings - q)]))
+            break
+    return xr.Dataset(
+        {
+            **_xv(params.model, "crossing", U, " at the crossing"),
+            "t": ("crossing", Tc, {"long_name": "time since the last transient crossing",
+                                   "units": "s"}),
+            "return_time": ("crossing", ret, {"long_name": "time from the crossing before",
+                                              "units": "s"}),
+            "cycle_crossings": ((), np.int64(q_found), {
+                "long_name": "crossings per cycle (0: no repetition found)", "units": "1"}),
+            "cycle_period": ((), period, {"long_name": "period of the cycle", "units": "s"}),
+            "at_equilibrium": ((), np.int8(at_rest), {
+                "long_name": "1: the crossings converge onto an equilibrium (the field "
+                             "vanishes at the last one to 1e-6)",
+                "flag_values": np.array([0, 1], np.int8),
+                "flag_meanings": "moving at_equilibrium"}),
+        },
+        coords={"crossing": np.arange(crossings)},
+        attrs=provenance_attrs(params, solver, analysis="surface_section", section=text,
+                               transient=transient, **start_attrs(u_start),
+                               max_time=flow.max_time),
+    )
+
+
+def limit_cycle(params, section="V", *, x0: float = 0.0, v0: float = 0.0, u0=None,
+                transient: int = 20, method: str = "exact", tol: float = 1e-10,
+                max_iter: int = 40, rtol: float = 1e-10, atol: float = 1e-12,
+                max_time: float = 1e4, samples: int = 400) -> xr.Dataset:
+    """A limit cycle of a self-excited system, stable or unstable, with its period, by Newton
+    shooting on ``section`` (see the module docstring) from the ``transient``-th crossing of
+    the trajectory from (x0, v0) (or ``u0``).
+
+    Returns a Dataset: ``period``, the section point (``X_section``, ``V_section``, ...), the
+    nontrivial
+    Floquet multipliers ``multiplier_real``/``_imag``/``_abs`` (n - 1 of them, largest modulus
+    first; the trivial 1 is removed), ``stable`` (all |mu| < 1 - 1e-6), ``max_X``, ``min_X``
+    and the cycle sampled at ``samples`` points (``X``, ``V``, ... and ``mode`` over ``t``);
+    attrs
+    ``status`` ("converged", "max_iter", "diverged", "singular", "no crossing: ...",
+    "integration failed: ...", "grazing the section ...", "not confirmed: ..."), ``iterations``,
+    ``residual``. A converged cycle is integrated once more without tangents and must close on
+    itself to ``CONFIRM_TOL``."""
+    from ..simulate import check_float, check_int, start_attrs
+    from .stability import damped_step
+    params, solver, flow, text = _setup(params, section, method, rtol, atol, max_time,
+                                        "limit_cycle")
+    transient = check_int("transient", transient, 1)
+    max_iter = check_int("max_iter", max_iter, 1)
+    samples = check_int("samples", samples, 2)
+    tol = check_float("tol", tol)
+    if not tol > 0:
+        raise ParameterError(f"tol: must be > 0, got {tol}")
+    n = params.model.n
+    u_start, s = _start(params, solver, x0, v0, u0)
+    status, _, _, _, _ = flow.crossings(s, transient)
+    a = flow.a
+    # an orthonormal basis B of the section's directions (the null space of a^T)
+    B = np.linalg.svd(a[None, :])[2][1:].T
+    from ..simulate import state_u
+    res, it, period, J = math.inf, 0, math.nan, None
+    if status == "ok":
+        status = "max_iter"
+        for it in range(1, max_iter + 1):
+            z = state_u(params.model, s)
+            got, s1, t1, dP = flow.return_map(s)
+            if got != "ok":
+                status = got
+                break
+            F = state_u(params.model, s1) - z
+            res = float(np.linalg.norm(F))
+            J = B.T @ dP @ B
+            period = t1
+            if res <= tol * (1.0 + float(np.linalg.norm(z))):
+                status = "converged"
+                break
+            try:
+                dw = np.linalg.solve(J - np.eye(n - 1), -B.T @ F)
+            except np.linalg.LinAlgError:
+                status = "singular"
+                break
+            def trial(zt):
+                st_t = _on_section(params, solver, s, zt)
+                s1t = st_t.copy()
+                got_t = flow.crossings(s1t, 1)[0]
+                return st_t, (float(np.linalg.norm(state_u(params.model, s1t) - zt))
+                              if got_t == "ok" else math.inf)
+            zt, st_t = damped_step(z, B @ dw, res, trial)
+            if zt is None:
+                status = "diverged"
+                break
+            s = st_t
+    mu = np.linalg.eigvals(J) if J is not None and np.all(np.isfinite(J)) else np.array([])
+    mu = mu[np.argsort(-np.abs(mu), kind="stable")]
+    converged = status == "converged"
+    z = state_u(params.model, s)
+    # the cycle itself, sampled, and the confirmation without tangents
+    U = np.full((samples, n), np.nan)
+    R = np.full(samples, -1, np.int8)
+    mx = mn = math.nan
+    if converged:
+        s_c = s.copy()
+        got, t_c, _, _, _ = flow.crossings(s_c, 1)
+        miss = (float(np.linalg.norm(state_u(params.model, s_c) - z)) if got == "ok"
+                else math.inf)
+        if not miss <= CONFIRM_TOL * (1.0 + float(np.linalg.norm(z))):
+            status, converged = f"not confirmed: integrated again, the cycle misses its start " \
+                                f"by {miss:.3g}", False
+        U, R, mx, mn = _sample_cycle(params, solver, s, period, samples)
+    absmu = np.abs(mu)
+    stable = bool(converged and absmu.size and np.all(absmu < 1.0 - 1e-6))
+    t = np.arange(samples) * (period / samples) if converged else np.full(samples, np.nan)
+    return xr.Dataset(
+        {
+            "period": ((), period if converged else math.nan,
+                       {"long_name": "period of the limit cycle", "units": "s"}),
+            **_xv(params.model, (), z, " of the cycle's point on the section", "_section"),
+            "multiplier_real": ("multiplier", mu.real, {"units": "1"}),
+            "multiplier_imag": ("multiplier", mu.imag, {"units": "1"}),
+            "multiplier_abs": ("multiplier", absmu, {
+                "long_name": "modulus of the nontrivial Floquet multipliers", "units": "1"}),
+            "stable": ((), np.int8(stable), {"long_name": "1: every nontrivial |mu| < 1 - 1e-6",
+                                             "flag_values": np.array([0, 1], np.int8),
+                                             "flag_meanings": "not_stable stable"}),
+            "max_X": ((), mx, {"long_name": "largest X over the cycle (samples)", "units": "1"}),
+            "min_X": ((), mn, {"long_name": "smallest X over the cycle (samples)",
+                               "units": "1"}),
+            **_xv(params.model, "t", U, " on the cycle"),
+            "mode": ("t", R, {"long_name": "mode at t",
+                              "flag_values": np.arange(len(params.model.mode_names),
+                                                       dtype=np.int8),
+                              "flag_meanings": " ".join(params.model.mode_names)}),
+        },
+        coords={"multiplier": np.arange(1, len(mu) + 1),
+                "t": ("t", t, {"long_name": "time from the section point", "units": "s"})},
+        attrs=provenance_attrs(params, solver, analysis="limit_cycle", section=text,
+                               transient=transient, **start_attrs(u_start), tol=tol,
+                               status=status, iterations=it, residual=res,
+                               converged=int(converged),
+                               verdict=("stable" if stable else "unstable") if converged
+                               else "not found"),
+    )
+
+
+def _on_section(params, solver, template, z):
+    """A kernel state at z with the template's mode if it still holds there (else
+    classified)."""
+    from ..kernels import mode_holds, run
+    from ..tangent import TangentSetup
+    setup = TangentSetup(solver)
+    zz = np.zeros(setup.N)
+    zz[:params.model.n] = z
+    s = setup.state_of(zz, template)
+    p = params.pack()
+    if not mode_holds(KERNEL_GENERIC, setup.fns, p, setup.opts, s):
+        s[ST_MODE] = -1.0
+        run(KERNEL_GENERIC, setup.fns, p, setup.opts, s, 1, 0, 0, *output_buffers(0))
+    return s
+
+
+def _sample_cycle(params, solver, state, period, samples):
+    """The cycle from ``state`` sampled at ``samples`` equal steps of its period: (U, modes,
+    max X, min X) (the kernel's output grid: intervals of T / per_period with T / per_period
+    a whole fraction of the cycle's period is not possible in general, so each sample is its
+    own call from the previous one: autonomous, the time origin does not matter)."""
+    from ..simulate import state_u
+    n = params.model.n
+    U = np.empty((samples, n))
+    R = np.empty(samples, np.int8)
+    p = params.pack()
+    opts = solver.opts()
+    s = state.copy()
+    dt = period / samples
+    mx, mn = -math.inf, math.inf
+    from ..kernels import run
+    for i in range(samples):
+        U[i] = state_u(params.model, s)
+        R[i] = int(s[ST_MODE])
+        # one output interval of length dt: a "period" T' = dt (omega' = 2 pi / dt)
+        pp = p.copy()
+        pp[params.model.index[params.model.omega]] = 2.0 * math.pi / dt
+        bufs = output_buffers(1)
+        code = run(KERNEL_GENERIC, solver.fns, pp, opts, s, 1, 0, 1, *bufs)
+        if code != st.OK:
+            U[i:] = np.nan
+            break
+        mx, mn = max(mx, float(bufs[4][0])), min(mn, float(bufs[5][0]))
+    return U, R, mx, mn
+
+
+def _newton_equilibrium(fns, mode, p, u, mem, tol=1e-12, max_iter=50):
+    """(converged, u, eigenvalues sorted by decreasing real part) of f(mode, u) = 0 from u."""
+    from ..models._probe import call_field, call_jacobian
+    n = u.size
+    u = u.copy()
+    f, J = np.zeros(n), np.zeros((n, n))
+    ok = False
+    for _ in range(max_iter):
+        call_field(fns, mode, 0.0, 1.0, 0.0, u, p, mem, f)
+        if np.linalg.norm(f) <= tol * (1.0 + np.linalg.norm(u)):
+            ok = True
+            break
+        call_jacobian(fns, mode, 0.0, 1.0, 0.0, u, p, mem, J)
+        try:
+            u = u - np.linalg.solve(J, f)
+        except np.linalg.LinAlgError:
+            break
+        if not np.all(np.isfinite(u)):
+            break
+    if not ok:
+        return False, u, None
+    call_jacobian(fns, mode, 0.0, 1.0, 0.0, u, p, mem, J)
+    ev = np.linalg.eigvals(J)
+    return True, u, ev[np.lexsort((-ev.imag, -ev.real))]
+
+
+def _holds(fns, mode, p, opts, u) -> bool:
+    """Does ``mode`` hold at the state u (its guards >= 0)?"""
+    from ..kernels import mode_holds
+    from ..integrate.contract import N_STATE, ST_EXTRA
+    n = u.size
+    s = np.zeros(N_STATE)
+    s[0], s[1], s[2], s[ST_MODE] = u[0], u[1], u[1], mode
+    s[ST_EXTRA:ST_EXTRA + n - 2] = u[2:]
+    return bool(mode_holds(KERNEL_GENERIC, fns, p, opts, s))
+
+
+def _eq_dataset(params, solver, found, dim, coord, extra=None, **attrs):
+    m = params.model
+    n = m.n
+    k = len(found)
+    U = np.array([f[0] for f in found]).reshape(k, n)
+    EV = np.array([f[2] for f in found]).reshape(k, n)
+    data = {
+        **_xv(m, dim, U, " at the equilibrium"),
+        "mode": (dim, np.array([f[1] for f in found], np.int8), {
+            "long_name": "mode of the equilibrium",
+            "flag_values": np.arange(len(m.mode_names), dtype=np.int8),
+            "flag_meanings": " ".join(m.mode_names)}),
+        "eigenvalue_real": ((dim, "eigenvalue"), EV.real, {"units": "1/s"}),
+        "eigenvalue_imag": ((dim, "eigenvalue"), EV.imag, {"units": "1/s"}),
+        "stable": (dim, np.array([bool(np.all(np.real(f[2]) < 0)) for f in found], np.int8),
+                   {"long_name": "1: every eigenvalue has a negative real part",
+                    "flag_values": np.array([0, 1], np.int8),
+                    "flag_meanings": "not_stable stable"}),
+    }
+    data.update(extra or {})
+    return xr.Dataset(data, coords={**coord, "eigenvalue": np.arange(1, n + 1),
+                                    },
+                      attrs=provenance_attrs(params, solver, **attrs))
+
+
+def equilibria(params, *, method: str = "exact", starts=None, tol: float = 1e-12,
+               max_iter: int = 50) -> xr.Dataset:
+    """Equilibria of a self-excited system in every mode of ``method``: Newton on
+    f(mode, u) = 0 with the mode's Jacobian from each start (``starts``: states, n numbers
+    each; default: the origin and +-1 along X and V), kept where the mode holds (its guards
+    >= 0 there), duplicates merged. Returns a Dataset over ``equilibrium``: ``u``
+    (equilibrium, component), ``mode``, ``eigenvalue_real``/``_imag`` (equilibrium,
+    eigenvalue; largest real part first) and ``stable`` (every real part < 0)."""
+    from ..simulate import check_params
+    params = check_params(params)
+    check_autonomous(params, "equilibria")
+    solver = Solver(method=method, model=params.model)
+    m = params.model
+    n = m.n
+    fns, p, opts = solver.fns, params.pack(), solver.opts()
+    if starts is None:
+        starts = [np.zeros(n)] + [sg * np.eye(n)[i] for i in range(min(n, 2)) for sg in (1, -1)]
+    starts = [np.asarray(u, dtype=float).ravel() for u in starts]
+    for u in starts:
+        if u.size != n or not np.all(np.isfinite(u)):
+            raise ParameterError(f"starts: each start needs {n} finite numbers "
+                                 f"({', '.join(m.state_names)})")
+    modes = solver.spec.modes or tuple(range(len(m.mode_names)))
+    mem = np.zeros(max(1, m.n_memory))
+    found = []
+    for mode in modes:
+        for u0 in starts:
+            ok, u, ev = _newton_equilibrium(fns, mode, p, u0, mem, tol, max_iter)
+            if not ok or not _holds(fns, mode, p, opts, u):
+                continue
+            if any(fm == mode and np.linalg.norm(fu - u) <= 1e-8 * (1 + np.linalg.norm(u))
+                   for fu, fm, _ in found):
+                continue
+            found.append((u, mode, ev))
+    return _eq_dataset(params, solver, found, "equilibrium",
+                       {"equilibrium": np.arange(len(found))}, analysis="equilibria")
+
+
+def _pair_real(ev) -> float:
+    """The largest real part of a complex pair of eigenvalues (NaN if none)."""
+    c = ev[np.abs(ev.imag) > 1e-12]
+    return float(np.max(c.real)) if c.size else math.nan
+
+
+def equilibrium_branch(params, param: str, values, *, method: str = "exact", start=None,
+                       mode: str | None = None) -> xr.Dataset:
+    """An equilibrium followed along ``param`` over ``values`` (sorted ascending; Newton from
+    the previous value's equilibrium, the first from ``start`` (n numbers) or the first one
+    :func:`equilibria` finds, in ``mode`` if named), with its eigenvalues at each value and its
+    Hopf points: where the largest real part of a complex pair changes sign, located to 1e-10
+    by the Illinois method. Returns a Dataset over ``param``: ``u``, ``mode``, the eigenvalues,
+    ``stable``, ``holds`` (the mode holds there: 0 where the equilibrium has left its mode,
+    its data NaN beyond a failed Newton), and over ``hopf``: ``hopf_<param>`` and
+    ``hopf_frequency`` (the imaginary part there, rad/s)."""
+    from ..integrate.roots import illinois_point, illinois_update
+    from ..simulate import check_params
+    from .bifurcation import check_values
+    params = check_params(params)
+    check_autonomous(params, "equilibrium_branch")
+    if not isinstance(param, str):
+        raise ParameterError(f"param: expected a parameter name, got {param!r}")
+    param = params.model.param(param).name
+    values = check_values(param, values)
+    for v in (values[0], values[-1]):
+        params.replace(**{param: float(v)})
+    solver = Solver(method=method, model=params.model)
+    m = params.model
+    n = m.n
+    fns, opts = solver.fns, solver.opts()
+    mem = np.zeros(max(1, m.n_memory))
+    first = equilibria(params.replace(**{param: float(values[0])}), method=method,
+                       starts=None if start is None else [start])
+    sel = np.arange(first.sizes["equilibrium"])
+    if mode is not None:
+        if mode not in m.mode_names:
+            raise ParameterError(f"mode: unknown mode {mode!r} (modes: "
+                                 f"{', '.join(m.mode_names)})")
+        sel = sel[first.mode.values == m.mode_names.index(mode)]
+    if sel.size == 0:
+        raise ParameterError(f"start: no equilibrium found at {param} = {values[0]:g}"
+                             + (f" in mode {mode}" if mode else ""))
+    from ..io import components
+    u = components(first).values[sel[0]]
+    code = int(first.mode.values[sel[0]])
+
+    def at(v, u0):
+        pv = params.replace(**{param: float(v)}).pack()
+        ok, uv, ev = _newton_equilibrium(fns, code, pv, u0, mem)
+        return ok, uv, ev, ok and _holds(fns, code, pv, opts, uv)
+
+    found, holds = [], []
+    for v in values:
+        ok, u1, ev, hd = at(v, u)
+        if not ok:
+            found.append((np.full(n, np.nan), code, np.full(n, np.nan + 0j)))
+            holds.append(False)
+            continue
+        u = u1
+        found.append((u1, code, ev))
+        holds.append(hd)
+    hopf = []
+    for i in range(len(values) - 1):
+        a, b = _pair_real(found[i][2]), _pair_real(found[i + 1][2])
+        if not (holds[i] and holds[i + 1]) or not (a * b < 0.0):
+            continue
+        lo, hi, glo, ghi, side = float(values[i]), float(values[i + 1]), a, b, 0
+        u_h, ev_h = found[i][0], found[i][2]
+        for _ in range(100):
+            if hi - lo <= 1e-10 * max(1.0, abs(hi)):
+                break
+            x = illinois_point(lo, hi, glo, ghi)
+            ok, u_h, ev_h, _ = at(x, u_h)
+            g = _pair_real(ev_h) if ok else math.nan
+            if not math.isfinite(g):
+                break
+            lo, hi, glo, ghi, side = illinois_update(lo, hi, glo, ghi, side, x, g)
+        w = float(np.max(np.abs(ev_h.imag))) if ev_h is not None else math.nan
+        hopf.append((0.5 * (lo + hi), w))
+    spec = m.param(param)
+    extra = {
+        "holds": (param, np.array(holds, np.int8), {
+            "long_name": "1: the equilibrium lies in its mode (its guards >= 0)",
+            "flag_values": np.array([0, 1], np.int8), "flag_meanings": "left holds"}),
+        f"hopf_{param}": ("hopf", np.array([h[0] for h in hopf], float), {
+            "long_name": f"{param} at the Hopf point", "units": spec.units}),
+        "hopf_frequency": ("hopf", np.array([h[1] for h in hopf], float), {
+            "long_name": "imaginary part of the critical pair at the Hopf point",
+            "units": "rad/s"}),
+    }
+    coord = {param: (param, values, {"long_name": spec.long_name, "units": spec.units}),
+             "hopf": np.arange(len(hopf))}
+    return _eq_dataset(params, solver, found, param, coord, extra, swept=(param,),
+                       analysis="equilibrium_branch", param=param)
+
+
+def limit_cycle_branch(params, param: str, values, section="V", *, x0: float = 0.0,
+                       v0: float = 0.0, u0=None, transient: int = 20, method: str = "exact",
+                       tol: float = 1e-10, rtol: float = 1e-10, atol: float = 1e-12,
+                       max_time: float = 1e4) -> xr.Dataset:
+    """A limit cycle followed along ``param`` over ``values`` (in the order given): the first
+    by :func:`limit_cycle` from (x0, v0) / ``u0`` after ``transient`` crossings, each next one
+    by Newton from the previous value's section point (natural-parameter continuation: it
+    follows stable and unstable cycles, not around folds). Returns a Dataset over ``param``:
+    ``period``, the section point (``X_section``, ``V_section``, ...), the nontrivial
+    multipliers (``multiplier_real``/``_imag``/``_abs`` over (param, multiplier)), ``stable``
+    and ``converged``; the branch stops (NaN after it) at the first value where no cycle is
+    found, the reason in the attr ``status``."""
+    from ..io import components
+    from ..simulate import check_params
+    params = check_params(params)
+    if not isinstance(param, str):
+        raise ParameterError(f"param: expected a parameter name, got {param!r}")
+    param = params.model.param(param).name
+    try:
+        values = np.asarray(values, dtype=float).ravel()
+    except (TypeError, ValueError):
+        raise ParameterError(f"values: expected numbers, got {values!r}") from None
+    if values.size < 1 or not np.all(np.isfinite(values)):
+        raise ParameterError(f"values: expected finite values of {param}")
+    n = params.model.n
+    m = n - 1
+    Z = np.full((values.size, n), np.nan)
+    MU = np.full((values.size, m), np.nan + 0j)
+    per = np.full(values.size, np.nan)
+    stable = np.zeros(values.size, np.int8)
+    conv = np.zeros(values.size, np.int8)
+    status = "completed"
+    start = dict(x0=x0, v0=v0, u0=u0, transient=transient)
+    text = ""
+    for i, v in enumerate(values):
+        lc = limit_cycle(params.replace(**{param: float(v)}), section, method=method, tol=tol,
+                         rtol=rtol, atol=atol, max_time=max_time, **start)
+        text = lc.attrs["section"]
+        if lc.attrs["status"] != "converged":
+            status = f"stopped at {param} = {v:g}: {lc.attrs['status']}"
+            break
+        z = components(lc, suffix="_section").values
+        Z[i], per[i] = z, float(lc.period)
+        mu = lc.multiplier_real.values + 1j * lc.multiplier_imag.values
+        MU[i, :mu.size] = mu
+        stable[i], conv[i] = int(lc.stable), 1
+        start = dict(u0=z, transient=1)
+    spec = params.model.param(param)
+    solver = Solver(method=method, rtol=rtol, atol=atol, model=params.model)
+    return xr.Dataset(
+        {
+            "period": (param, per, {"long_name": "period of the limit cycle", "units": "s"}),
+            **_xv(params.model, param, Z, " of the cycle's point on the section", "_section"),
+            "multiplier_real": ((param, "multiplier"), MU.real, {"units": "1"}),
+            "multiplier_imag": ((param, "multiplier"), MU.imag, {"units": "1"}),
+            "multiplier_abs": ((param, "multiplier"), np.abs(MU), {
+                "long_name": "modulus of the nontrivial Floquet multipliers", "units": "1"}),
+            "stable": (param, stable, {"long_name": "1: every nontrivial |mu| < 1 - 1e-6",
+                                       "flag_values": np.array([0, 1], np.int8),
+                                       "flag_meanings": "not_stable stable"}),
+            "converged": (param, conv, {"long_name": "1: a cycle was found at this value",
+                                        "flag_values": np.array([0, 1], np.int8),
+                                        "flag_meanings": "not_found converged"}),
+        },
+        coords={param: (param, values, {"long_name": spec.long_name, "units": spec.units}),
+                "multiplier": np.arange(1, m + 1)},
+        attrs=provenance_attrs(params, solver, swept=(param,), analysis="limit_cycle_branch",
+                               param=param, section=text, status=status),
+    )
