@@ -165,7 +165,84 @@ def test_stribeck_stick_slip_cycle_coexists_with_stable_steady_sliding():
     assert int(near.at_equilibrium) == 1 and int(near.cycle_crossings) == 0
     far = ns.surface_section(p, "V", crossings=10, transient=50, x0=x_eq, v0=1.0)
     assert int(far.at_equilibrium) == 0 and int(far.cycle_crossings) == 1
-    lc = ns.limit_cycle(p, "V", x0=x_eq, v0=1.0)
+    lc = ns.limit_cycle(p, "V", x0=x_eq, v0=1.0)  # Stribeck slip: RKF45, not closed form
     assert lc.attrs["status"] == "converged" and int(lc.stable) == 1
     assert float(lc.period) == pytest.approx(float(far.cycle_period), abs=1e-8)
+    # a stop on a crossing starts the next call on the surface: never a crossing of its own
+    assert np.all(far.return_time.values > 5.0) and float(lc.period) > 5.0
     assert (lc.mode.values == M.mode_names.index("stick")).any()
+
+
+def scipy_stick_slip(p, x0, v0, t_end=1000.0, window=200.0):
+    """An independent event-driven solution of the unforced belt oscillator (Stribeck slip by
+    scipy DOP853, each slip direction's field continued through v_rel = 0, which is located as
+    an event; stick in closed form, X = X0 + v_belt t,
+    until the friction needed, omega0^2 X + xi v_belt, reaches mu_s). Returns whether the mass
+    stuck to the belt during the last ``window`` time units (the stick-slip cycle) and the
+    final state."""
+    from scipy.integrate import solve_ivp
+    vb = p.v_belt
+
+    def mu(v):
+        return p.mu_k + (p.mu_s - p.mu_k) * math.exp(-v / p.v_s)
+
+    def field(sigma):  # slip in the direction sigma = sign(v_rel), continued through 0
+        def rhs(t, u):
+            f = -sigma * mu(sigma * (u[1] - vb))
+            return [u[1], -p.omega0**2 * u[0] - p.xi * u[1] + f]
+        return rhs
+
+    t, u, last_stick = 0.0, np.array([x0, v0], float), -math.inf
+    while t < t_end:
+        if abs(u[1] - vb) < 1e-12:  # at the belt's speed: stick or slip?
+            f_req = p.omega0**2 * u[0] + p.xi * vb
+            if abs(f_req) <= p.mu_s:
+                x_end = (p.mu_s - p.xi * vb) / p.omega0**2
+                dt = (x_end - u[0]) / vb
+                t, u = t + dt, np.array([x_end, vb - 1e-9])  # stick, then slip backward
+                last_stick = t
+                continue
+            u[1] = vb - 1e-9 if f_req > p.mu_s else vb + 1e-9
+
+        def hit(t, u):
+            return u[1] - vb
+        # leaving backward slip (v_rel < 0) means v_rel rising through 0, and vice versa
+        sigma = -1.0 if u[1] < vb else 1.0
+        hit.terminal, hit.direction = True, -sigma
+        sol = solve_ivp(field(sigma), (t, t_end), u, method="DOP853", rtol=1e-10, atol=1e-12,
+                        events=hit)
+        t, u = sol.t[-1], sol.y[:, -1].copy()
+        if sol.status == 1:
+            u[1] = vb
+    return last_stick > t_end - window, u
+
+
+def test_surface_basins_share_of_the_stick_slip_cycle_against_scipy():
+    """Above the subcritical Hopf point the stable steady sliding (inside an unstable cycle)
+    and the stick-slip cycle share the plane: every initial condition of a grid gets the
+    attractor that an independent scipy event-driven solution reaches."""
+    p = M.params(v_s=0.5, xi=0.68)
+    bas = ns.surface_basins(p, "V", x=(0.6, 1.1), v=(-0.3, 0.3), grid=4, transient=500)
+    assert float(bas.undecided_fraction) == 0.0 and bas.sizes["attractor"] == 2
+    kinds = bas.kind.values
+    cycle = int(np.flatnonzero(kinds == 1)[0])
+    assert int(bas.crossings[cycle]) == 1
+    agree = 0
+    for j, v0 in enumerate(bas.v0.values):
+        for i, x0 in enumerate(bas.x0.values):
+            stuck, _ = scipy_stick_slip(p, x0, v0)
+            agree += (int(bas.label[j, i]) == cycle) == stuck
+    assert agree == 16
+    assert 0.0 < float(bas.fraction[cycle]) < 1.0  # both attractors have a share
+
+
+def test_a_reset_that_jumps_across_the_section_is_no_crossing():
+    """The unforced impact oscillator from a large amplitude: while it hits the stop (X = 1,
+    V -> -r V) the decreasing crossings of V = 0 are the impacts' jumps, which are not
+    crossings of the flow; once the amplitude has decayed below the stop, V = 0 is crossed
+    smoothly at the top of each swing, below X = 1."""
+    p = ns.model("impact").params(F0=0.0, xi=0.1)
+    sec = ns.surface_section(p, "V", crossings=20, transient=0, x0=-3.0)
+    assert np.all(sec.X.values < 1.0 - 1e-6)
+    assert np.all(np.abs(sec.V.values) < 1e-9)
+    assert np.all(np.diff(sec.X.values) < 0)  # decaying swings

@@ -42,6 +42,7 @@ _LAZY = {
     "equilibria": ".analysis.autonomous",
     "equilibrium_branch": ".analysis.autonomous",
     "limit_cycle_branch": ".analysis.autonomous",
+    "surface_basins": ".analysis.autonomous",
     "reproduce": ".reproduction",
 }
 
@@ -52,7 +53,7 @@ _SUBMODULES = ("analysis", "cli", "errors", "integrate", "io", "kernels", "model
 __all__ = ["__version__", "Params", "PARAM_NAMES", "model", "models", "model_from_equations", "Guard", "preset", "PRESETS", "simulate", "reproduce", "Solver",
            "eta_study", "lyapunov", "periodic_orbit", "continuation", "two_parameter_curve", "parameter_map", "poincare", "bifurcation_diagram", "resonance_curve", "basins",
            "surface_section", "limit_cycle", "equilibria", "equilibrium_branch",
-           "limit_cycle_branch",
+           "limit_cycle_branch", "surface_basins",
            "NonsmoothError", "ParameterError", "OutputError", "IntegrationError"]
 
 

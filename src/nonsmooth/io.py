@@ -258,8 +258,16 @@ def component_names(state_names) -> list[str]:
     names (``u<i>`` where a name would clash with X or V)."""
     names = ["X", "V"]
     for i, nm in enumerate(tuple(state_names)[2:], start=2):
-        names.append(nm if nm not in ("X", "V") else f"u{i}")
+        names.append(nm if nm not in _RESULT_NAMES else f"u{i}")
     return names
+
+
+#: Names the analyses' results use for other things (a state component called so is written
+#: as u<i>).
+_RESULT_NAMES = frozenset(
+    "X V t n i j mode region visited period status sample point special crossing attractor "
+    "label kind count fraction stable contact converged multiplier component row col "
+    "eigenvalue equilibrium hopf".split())
 
 
 def components(ds, prefix: str = "", suffix: str = ""):
@@ -274,7 +282,9 @@ def components(ds, prefix: str = "", suffix: str = ""):
     names = [f"{prefix}{nm}{suffix}" for nm in component_names(state)]
     missing = [nm for nm in names if nm not in ds.variables]
     if missing:
-        raise KeyError(f"components: the dataset has no variable {missing[0]!r}")
+        from .errors import ParameterError
+        raise ParameterError(f"components: the dataset has no variable {missing[0]!r} (give "
+                             f"the prefix / suffix of the analysis' state variables)")
     dims = ds[names[0]].dims
     data = np.stack([ds[nm].values for nm in names], axis=-1)
     coords = {d: ds[d] for d in dims if d in ds.coords}

@@ -122,6 +122,12 @@ def start_attrs(u) -> dict:
     return {"x0": float(u[0]), "v0": float(u[1]), "u0": np.asarray(u, dtype=np.float64)}
 
 
+def xv_units(model) -> tuple:
+    """The units of X and V (the model's ``state_units``; "1", "1/s" where it names none)."""
+    u = tuple(model.state_units) + ("1", "1/s")[len(model.state_units):]
+    return u[0], u[1]
+
+
 def component_names(model) -> list[str]:
     """The variable name of each state component of ``model`` in a result (see
     ``io.component_names``)."""
@@ -239,6 +245,7 @@ def simulate(params: ParamsBase, *, periods: int, transient: int = 0,
     Xmin = np.concatenate([[state[0]], rec["Xmin"][0]])
     U = np.concatenate([state_u(params.model, state)[None, :], rec["U"][0]])
     T = params.period
+    ux, uv = xv_units(params.model)
     t0 = transient * T + solver.section_phase / getattr(params, params.model.omega)
     t = t0 + np.arange(n + 1) * (T / spp)
     modes = params.model.mode_names
@@ -246,8 +253,9 @@ def simulate(params: ParamsBase, *, periods: int, transient: int = 0,
     masks = flag_attrs(modes, dtype=np.uint8, masks=True)
     ds = xr.Dataset(
         {
-            "X": ("t", X, {"long_name": "displacement X = x/g", "units": "1"}),
-            "V": ("t", V, {"long_name": "velocity dX/dt", "units": "1/s"}),
+            "X": ("t", X, {"long_name": "displacement X = x/g" if params.model.name == "support"
+                           else "displacement X", "units": ux}),
+            "V": ("t", V, {"long_name": "velocity dX/dt", "units": uv}),
             "region": ("t", R, dict(regions, long_name="region of eq. 14 at t")),
             "visited": ("t", M, dict(masks, long_name="regions visited since the previous "
                                                       "sample")),

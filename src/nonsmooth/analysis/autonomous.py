@@ -103,8 +103,13 @@ def parse_section(params, section):
     return H, DIRECTIONS[direction], f"{section} = 0, {direction}"
 
 
-def check_autonomous(params, who: str) -> None:
-    """A one-line ParameterError if the model's forcing amplitude is not 0."""
+def check_autonomous(params, who: str, solver=None) -> None:
+    """A one-line ParameterError if the model's forcing amplitude is not 0 (a model that
+    names none is taken as unforced), or, with ``solver``, if its method carries continuous
+    memory (the section point would have to include it)."""
+    if solver is not None and solver.spec.continuous_memory:
+        raise ParameterError(f"{who}: method {solver.method!r} of {params.model.name} carries "
+                             f"a continuous memory slot; use another method (e.g. exact)")
     fa = params.model.forcing_amplitude
     if fa and fa in params.model.param_names and float(getattr(params, fa)) != 0.0:
         raise ParameterError(f"{who}: the system is forced ({fa} = {getattr(params, fa):g}): "
@@ -150,9 +155,12 @@ class _Flow:
         """The field f at a kernel state (its mode)."""
         from ..models._probe import call_field
         from ..simulate import state_u
+        from ..integrate.contract import ST_EXTRA
         u = state_u(self.model, state)
         du = np.zeros(self.model.n)
-        mem = np.zeros(max(1, self.model.n_memory))
+        nm = self.model.n_memory
+        mem = np.zeros(max(1, nm))
+        mem[:nm] = state[ST_EXTRA + self.model.n - 2:ST_EXTRA + self.model.n - 2 + nm]
         call_field(self.setup.fns, int(state[ST_MODE]), 0.0, 1.0, 0.0, u, self.p, mem, du)
         return du
 
@@ -185,8 +193,8 @@ def _start(params, solver, x0, v0, u0):
 def _setup(params, section, method, rtol, atol, max_time, who):
     from ..simulate import check_float, check_params
     params = check_params(params)
-    check_autonomous(params, who)
     solver = Solver(method=method, rtol=rtol, atol=atol, model=params.model)
+    check_autonomous(params, who, solver)
     H, direction, text = parse_section(params, section)
     max_time = check_float("max_time", max_time)
     if not max_time > 0:
@@ -495,7 +503,8 @@ def _eq_dataset(params, solver, found, dim, coord, extra=None, **attrs):
 
 def equilibria(params, *, method: str = "exact", starts=None, tol: float = 1e-12,
                max_iter: int = 50) -> xr.Dataset:
-    """Equilibria of a self-excited system in every mode of ``method``: Newton on
+    """Equilibria of a self-excited system in every mode of ``method`` (a mode's memory slots
+    at 0): Newton on
     f(mode, u) = 0 with the mode's Jacobian from each start (``starts``: states, n numbers
     each; default: the origin and +-1 along X and V), kept where the mode holds (its guards
     >= 0 there), duplicates merged. Returns a Dataset over ``equilibrium``: ``u``
@@ -503,8 +512,8 @@ def equilibria(params, *, method: str = "exact", starts=None, tol: float = 1e-12
     eigenvalue; largest real part first) and ``stable`` (every real part < 0)."""
     from ..simulate import check_params
     params = check_params(params)
-    check_autonomous(params, "equilibria")
     solver = Solver(method=method, model=params.model)
+    check_autonomous(params, "equilibria", solver)
     m = params.model
     n = m.n
     fns, p, opts = solver.fns, params.pack(), solver.opts()
@@ -531,10 +540,18 @@ def equilibria(params, *, method: str = "exact", starts=None, tol: float = 1e-12
                        {"equilibrium": np.arange(len(found))}, analysis="equilibria")
 
 
-def _pair_real(ev) -> float:
-    """The largest real part of a complex pair of eigenvalues (NaN if none)."""
+def _pair(ev):
+    """(real part, |imaginary part|) of the complex pair of eigenvalues with the largest real
+    part ((NaN, NaN) if none)."""
     c = ev[np.abs(ev.imag) > 1e-12]
-    return float(np.max(c.real)) if c.size else math.nan
+    if not c.size:
+        return math.nan, math.nan
+    e = c[int(np.argmax(c.real))]
+    return float(e.real), float(abs(e.imag))
+
+
+def _pair_real(ev) -> float:
+    return _pair(ev)[0]
 
 
 def equilibrium_branch(params, param: str, values, *, method: str = "exact", start=None,
@@ -609,8 +626,9 @@ def equilibrium_branch(params, param: str, values, *, method: str = "exact", sta
             if not math.isfinite(g):
                 break
             lo, hi, glo, ghi, side = illinois_update(lo, hi, glo, ghi, side, x, g)
-        w = float(np.max(np.abs(ev_h.imag))) if ev_h is not None else math.nan
-        hopf.append((0.5 * (lo + hi), w))
+        if not hi - lo <= 1e-10 * max(1.0, abs(hi)):
+            continue  # Newton failed inside the bracket: not located, not reported
+        hopf.append((0.5 * (lo + hi), _pair(ev_h)[1]))
     spec = m.param(param)
     extra = {
         "holds": (param, np.array(holds, np.int8), {
@@ -696,4 +714,124 @@ def limit_cycle_branch(params, param: str, values, section="V", *, x0: float = 0
                 "multiplier": np.arange(1, m + 1)},
         attrs=provenance_attrs(params, solver, swept=(param,), analysis="limit_cycle_branch",
                                param=param, section=text, status=status),
+    )
+
+
+#: Labels of :func:`surface_basins` that are not an attractor.
+LABEL_UNDECIDED = -1
+
+
+def surface_basins(params, section="V", *, x=(-1.0, 1.0), v=(-1.0, 1.0), grid=20,
+                   u0=None, transient: int = 50, record: int = 32, max_period: int = 8,
+                   method: str = "exact", rtol: float = 1e-10, atol: float = 1e-12,
+                   max_time: float = 1e4, progress=None) -> xr.Dataset:
+    """Basins of attraction of a self-excited system over a grid of initial (X, V) (the other
+    components from ``u0``, else 0), "featurize, then group" on a section surface: each
+    initial condition runs ``transient`` crossings of ``section``, then ``record`` more; it
+    ends at an **equilibrium** when its crossings converge onto one (the field vanishes at the
+    last crossing to 1e-6, or the orbit stops crossing within ``max_time`` and comes to rest),
+    on a **cycle** when its crossings repeat after q <= ``max_period`` of them (to 1e-6 of the
+    scale), else it is undecided (-1: chaotic, quasi-periodic, still converging, or failed).
+    Equilibria are matched by their state, cycles by their section points (any phase), both to
+    1e-4 of the scale.
+
+    Returns a Dataset with ``label`` (v0, x0) (CF flags, -1 undecided) and per ``attractor``:
+    ``kind`` (0 equilibrium, 1 cycle), ``fraction``, ``count``, ``crossings`` (q; 0 for an
+    equilibrium) and its state (``X``, ``V``, ...: the equilibrium, or a cycle's first section
+    point); ``undecided_fraction``. The points run one after the other (a Python loop over the
+    compiled kernel): for grids of hundreds of points, not of a million."""
+    from ..simulate import check_int, initial_u, state_from_u, state_u
+    from ..sweep import progress_callback
+    from .basins import _check_grid, _check_range
+    from ..kernels import run
+    progress = progress_callback(progress, "surface_basins")
+    params, solver, flow, text = _setup(params, section, method, rtol, atol, max_time,
+                                        "surface_basins")
+    x_lo, x_hi = _check_range("x", x)
+    v_lo, v_hi = _check_range("v", v)
+    nx, nv = _check_grid(grid)
+    transient = check_int("transient", transient, 0)
+    record = check_int("record", record, 2)
+    max_period = check_int("max_period", max_period, 1)
+    if 2 * max_period > record:
+        raise ParameterError(f"record: must be >= 2 max_period = {2 * max_period}, got {record}")
+    base = initial_u(params.model, 0.0, 0.0, u0)
+    xs, vs = np.linspace(x_lo, x_hi, nx), np.linspace(v_lo, v_hi, nv)
+    scale = max(abs(x_lo), abs(x_hi), abs(v_lo), abs(v_hi), 1.0)
+    p, opts = params.pack(), solver.opts()
+    found = []  # (kind, q, points (q x n))
+    label = np.full((nv, nx), LABEL_UNDECIDED, np.int64)
+    match = 1e-4 * scale
+
+    def classify(s):
+        status, _, _, _, _ = flow.crossings(s, transient) if transient else ("ok",) * 5
+        if status == "ok":
+            status, _, U, _, _ = flow.crossings(s, record, record=record)
+        if status != "ok":  # no more crossings: at rest, or failed / escaped
+            if status.startswith("no crossing") and np.linalg.norm(flow.field(s)) <= 1e-6 * (
+                    1.0 + np.linalg.norm(state_u(params.model, s))):
+                return 0, 0, state_u(params.model, s)[None, :]
+            return None
+        tol = 1e-6 * (1.0 + float(np.max(np.abs(U))))
+        if np.linalg.norm(flow.field(s)) <= tol:
+            return 0, 0, U[-1:]
+        for q in range(1, max_period + 1):
+            if np.max(np.abs(U[q:] - U[:-q])) <= tol:
+                return 1, q, U[-q:]
+        return None
+
+    done = 0
+    for j, v0 in enumerate(vs):
+        for i, x0 in enumerate(xs):
+            u = base.copy()
+            u[0], u[1] = x0, v0
+            s = state_from_u(u)
+            run(KERNEL_GENERIC, solver.fns, p, opts, s, 1, 0, 0, *output_buffers(0))
+            feat = classify(s)
+            done += 1
+            if progress is not None:
+                progress(done, nx * nv)
+            if feat is None:
+                continue
+            kind, q, pts = feat
+            for k, (kk, qq, ref) in enumerate(found):
+                if kk == kind and qq == q and min(np.linalg.norm(ref - pt, axis=1).min()
+                                                  for pt in pts) <= match:
+                    label[j, i] = k
+                    break
+            else:
+                found.append((kind, q, pts))
+                label[j, i] = len(found) - 1
+    na = len(found)
+    counts = np.array([int(np.sum(label == k)) for k in range(na)], np.int64)
+    first = np.array([f[2][0] for f in found]).reshape(na, params.model.n)
+    from ..io import flag_attrs
+    names = [("equilibrium" if f[0] == 0 else f"cycle_{f[1]}") + f"_{k}"
+             for k, f in enumerate(found)]
+    lab_attrs = dict(long_name="attractor reached (-1: undecided)")
+    if na:
+        lab_attrs.update(flag_values=np.arange(-1, na, dtype=np.int64),
+                         flag_meanings=" ".join(["undecided"] + names))
+    return xr.Dataset(
+        {
+            "label": (("v0", "x0"), label, lab_attrs),
+            "kind": ("attractor", np.array([f[0] for f in found], np.int8), flag_attrs(
+                ("equilibrium", "cycle"), dtype=np.int8, long_name="kind of attractor")),
+            "fraction": ("attractor", counts / (nx * nv), {
+                "long_name": "fraction of the grid attracted", "units": "1"}),
+            "count": ("attractor", counts, {"long_name": "grid points attracted", "units": "1"}),
+            "crossings": ("attractor", np.array([f[1] for f in found], np.int64), {
+                "long_name": "crossings of the section per cycle (0: equilibrium)",
+                "units": "1"}),
+            **_xv(params.model, "attractor", first, " of the attractor (an equilibrium, or a "
+                  "cycle's first section point)"),
+            "undecided_fraction": ((), float(np.mean(label == LABEL_UNDECIDED)), {
+                "long_name": "fraction of the grid undecided", "units": "1"}),
+        },
+        coords={"x0": ("x0", xs, {"long_name": "initial X", "units": "1"}),
+                "v0": ("v0", vs, {"long_name": "initial V", "units": "1/s"}),
+                "attractor": np.arange(na)},
+        attrs=provenance_attrs(params, solver, analysis="surface_basins", section=text,
+                               transient=transient, record=record, max_period=max_period,
+                               max_time=flow.max_time, u0=base),
     )

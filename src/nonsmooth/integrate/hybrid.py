@@ -455,6 +455,28 @@ def _immediate_exit(G, ng, n, u, f0, C, S, om):
     return -1
 
 
+@nb.njit(cache=True, inline="always")
+def _section_side(G, k, H, n, u, f, C, S, om):
+    """Orientation (+-1) of the section row h = H . (u, 1, C, S) written to G[k]: the side of
+    the surface the state is on, or, within round-off of the surface (a state stopped on a
+    crossing, a reset onto it), the side it moves to (h')."""
+    for i in range(n + 3):
+        G[k, i] = H[i]
+    h = _gval(G, k, n, u, C, S)
+    scale = abs(H[n]) + abs(H[n + 1]) + abs(H[n + 2])
+    for i in range(n):
+        scale += abs(H[i] * u[i])
+    sgn = 1.0
+    if abs(h) <= 1e-9 * scale:
+        if _dgval(G, k, n, f, C, S, om) < 0.0:
+            sgn = -1.0
+    elif h < 0.0:
+        sgn = -1.0
+    for i in range(n + 3):
+        G[k, i] = sgn * H[i]
+    return sgn
+
+
 @nb.njit(cache=True, inline="always", fastmath=_FM)
 def _cf_state(MC, mode, om, y0, z0, C, S, hs, u1, f1):
     """Closed-form state at hs from the homogeneous part (y0, z0) and the forcing phase (C, S):
@@ -816,15 +838,8 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
             _store(state, u, n, mem, nmem, mode, h)
             keep_alive(ws)
             return st.EVENT_FAILED
-        for i in range(n + 3):
-            G[ng, i] = H[i]
-        f_dummy = f0  # h and h' at the start: on the surface, the side it moves to
-        field(mode, t0, C0, S0, u, pp, mem, f_dummy)
-        h0 = _gval(G, ng, n, u, C0, S0)
-        if h0 < 0.0 or (h0 == 0.0 and _dgval(G, ng, n, f_dummy, C0, S0, om) < 0.0):
-            sgn = -1.0
-        for i in range(n + 3):
-            G[ng, i] = sgn * H[i]
+        field(mode, t0, C0, S0, u, pp, mem, f0)  # (f0 is computed again below)
+        sgn = _section_side(G, ng, H, n, u, f0, C0, S0, om)
         ksec = ng
         ng += 1
     cls = _mode_class(linear, closed, mode, pp, lin, MC, mcs, om, MF)
@@ -1084,8 +1099,6 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
                     if ng >= MAX_GUARDS:
                         code = st.EVENT_FAILED
                         break
-                    for i in range(n + 3):
-                        G[ng, i] = sgn * H[i]
                     ksec = ng
                     ng += 1
                 cls = _mode_class(linear, closed, mode, pp, lin, MC, mcs, om, MF)
@@ -1093,9 +1106,11 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
                     code = st.RESONANCE
                     break
                 cf = cls == _MC_CLOSED
+                _deriv(cf, field, mode, tau, C, S, u, pp, mem, f0, MC, om)
+                if has_sec:  # the side after the reset: a jump across the surface is no
+                    sgn = _section_side(G, ksec, H, n, u, f0, C, S, om)  # crossing
                 if cf:
                     _cf_bounds(MC, mode, om, G, ng, n, GB)
-                _deriv(cf, field, mode, tau, C, S, u, pp, mem, f0, MC, om)
                 if tan and not _saltation(transition, old_mode, k_tr, tau, C, S, om, n, ue, me,
                                           fm, gk, gdot, mode, u, mem, f0, pp, Y, cmi, uc, mc,
                                           ua, ma, n_tiny > 0, tw_last):
@@ -1170,7 +1185,9 @@ def advance_tangent(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out
     ``SEC[1]`` = m > 0 the call stops at the m-th recorded crossing (mid-period: for an
     autonomous system, whose field does not depend on t), Y and ``state`` then hold the
     crossing, and ``SEC[3]`` the time since the call began (else the time integrated). A state
-    on the surface at the start is not a crossing."""
+    on the surface at the start (within 1e-9 of its scale: a stop on a crossing) is not a
+    crossing: the side it moves to counts; a reset that jumps across the surface is not one
+    either (the side is taken again after every transition)."""
     if Y.shape[0] != int(opts[OPT_N]) + len(cmi) or (qr == 1 and (
             per_period != 1 or L_out.shape[0] < n_out or L_out.shape[1] < Y.shape[1])) or (
             U_out.shape[0] > 0 and (U_out.shape[0] < n_out or U_out.shape[1] < int(opts[OPT_N]))) or (

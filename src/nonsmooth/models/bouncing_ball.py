@@ -69,6 +69,7 @@ MODEL = model_from_equations(
             description="compliant table (spring-damper restituting r), RKF45"),
     },
     description="a ball bouncing on a harmonically vibrating table (relative height Z)",
+    forcing_amplitude="A",
     state_units=("m", "m/s"),
     state_long_names=("height above the table Z = x - y", "relative velocity dZ/dt"),
     contact_modes=("stuck", "contact"),

@@ -84,6 +84,7 @@ MODEL = model_from_equations(
             description="compliant stop (spring-damper restituting about r), RKF45"),
     },
     description="two masses in series, the primary one hitting a rigid stop",
+    forcing_amplitude="F0",
     state_units=("m", "m/s", "m", "m/s"),
     state_long_names=("primary displacement X", "primary velocity dX/dt",
                       "secondary displacement Y", "secondary velocity dY/dt"),
