@@ -198,7 +198,13 @@ class SameModel:
                     raise RuntimeError(f"no progress at t = {t:.6g} (repeated events)")
                 n_ev += 1
                 continue
-            sol = solve_ivp(self.field(mode), (t, t_end), u, events=self.events(mode, t, u), **opts)
+            # a guard with forcing terms (a time-dependent surface) can dip below zero and come
+            # back inside one long step (a zero field, e.g. a ball resting on its table, lets
+            # the steps grow without bound): steps of at most T/8 see every such dip
+            ng = int(call_guards(self.fns, mode, self.p, self.mem, self.G))
+            timed = bool(np.any(self.G[:ng, self.n + 1:self.n + 3] != 0.0))
+            kw = dict(opts, max_step=math.pi / (4.0 * self.om)) if timed else opts
+            sol = solve_ivp(self.field(mode), (t, t_end), u, events=self.events(mode, t, u), **kw)
             nfev += sol.nfev
             if sol.status == -1:
                 raise RuntimeError(f"solve_ivp failed: {sol.message}")

@@ -174,3 +174,36 @@ def test_cli_starts_from_u0_shows_the_named_components_and_refuses_unknown_ones(
         code, _, err = run_cli(argv + ["--plot", str(tmp_path / "x.png")], capsys)
         assert code == 2
         one_line(err, needle)
+
+
+def test_a_start_beyond_the_stop_or_below_the_table_is_refused(capsys):
+    """The exact methods admit only states on the free side of their rigid obstacle (the
+    smooth ones, whose obstacle is compliant, admit any)."""
+    from cli_helpers import one_line, run_cli
+    with pytest.raises(ParameterError, match=r"u0: the start \(X=0.7, V=0, Y=0, W=0\) is "
+                                             r"outside what impact_2dof \(exact\) admits: "
+                                             r"X <= delta"):
+        ns.simulate(P, periods=1, x0=0.7, method="exact")
+    ball = ns.model("bouncing_ball").preset("period_one")
+    for call in (lambda: ns.periodic_orbit(ball, x0=-0.1, method="exact"),
+                 lambda: ns.bifurcation_diagram(ball, "A", [0.03, 0.04], x0=-0.1,
+                                                method="exact")):
+        with pytest.raises(ParameterError, match=r"admits: Z >= 0"):
+            call()
+    assert ns.simulate(ball, periods=1, x0=-0.01, method="smooth").sizes["t"] > 0
+    code, _, err = run_cli(["simulate", "-m", "impact_2dof", "--method", "exact", "--x0", "0.7",
+                            "--plot", "/tmp/never.png"], capsys)
+    assert code == 2
+    one_line(err, "outside what impact_2dof (exact) admits: X <= delta")
+
+
+def test_x_and_v_quantities_carry_the_models_units():
+    po = ns.poincare(P, transient=20, record=4, method="exact", lyapunov=False)
+    for name in ("X", "max_X", "min_X", "orbit_X", "Y", "orbit_Y"):
+        assert po[name].attrs["units"] == "m", name
+    for name in ("V", "orbit_V", "W"):
+        assert po[name].attrs["units"] == "m/s", name
+    bif = ns.bifurcation_diagram(P, "omega", [0.9, 1.0], transient=20, record=4,
+                                 method="exact", lyapunov=False)
+    assert bif.X.attrs["units"] == "m" and bif.max_X.attrs["units"] == "m"
+    assert ns.preset("table3").model.state_units == ("1", "1/s")  # the paper's, unchanged

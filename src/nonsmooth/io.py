@@ -7,6 +7,8 @@ interrupted or killed write, and the files written are recorded (:func:`written_
 
 from __future__ import annotations
 
+import re
+
 import contextlib
 import math
 import os
@@ -290,3 +292,20 @@ def components(ds, prefix: str = "", suffix: str = ""):
     coords = {d: ds[d] for d in dims if d in ds.coords}
     return xr.DataArray(data, dims=dims + ("component",),
                         coords={**coords, "component": state}, name=f"{prefix}u{suffix}")
+
+
+_X_NAME = re.compile(r"(^|_)(X|x0)($|_)")
+_V_NAME = re.compile(r"(^|_)(V|v0)($|_)")
+
+
+def apply_state_units(ds, model):
+    """The units of every variable and coordinate of ``ds`` holding X or V (``X``, ``max_X``,
+    ``X_section``, ``orbit_V``, ``x0``, ...) from the model's ``state_units`` (the analyses
+    write "1" and "1/s", the paper's dimensionless units); returns ``ds``."""
+    ux, uv = (tuple(model.state_units) + ("1", "1/s")[len(model.state_units):])[:2]
+    for name in list(ds.data_vars) + list(ds.coords):
+        if _X_NAME.search(str(name)):
+            ds[name].attrs["units"] = ux
+        elif _V_NAME.search(str(name)):
+            ds[name].attrs["units"] = uv
+    return ds

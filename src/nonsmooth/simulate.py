@@ -11,7 +11,7 @@ import xarray as xr
 from . import status as st
 from .errors import IntegrationError, ParameterError
 from .integrate.contract import ST_EXTRA, ST_MODE
-from .io import provenance_attrs
+from .io import apply_state_units, provenance_attrs
 from .kernels import Solver, new_state
 from .models.base import ParamsBase
 
@@ -101,6 +101,16 @@ def state_from_u(u) -> np.ndarray:
     return new_state(float(u[0]), float(u[1]), tuple(float(x) for x in u[2:]))
 
 
+def check_admissible(solver, params, u, field: str = "u0") -> None:
+    """A one-line ParameterError naming ``field`` if the start u is outside the admissible set
+    of the solver's method (``Method.admissible``, e.g. a ball below its table)."""
+    m = solver.spec
+    if m.admissible is not None and not m.admissible(u, params):
+        state = ", ".join(f"{nm}={float(x):g}" for nm, x in zip(params.model.state_names, u))
+        raise ParameterError(f"{field}: the start ({state}) is outside what {params.model.name}"
+                             f" ({solver.method}) admits: {m.admissible_text}")
+
+
 def start_trajectory(params, x0, v0, method, rtol, atol, section_phase=0.0, u0=None):
     """Validated single-trajectory set-up: (params, solver, packed params, kernel opts, initial
     kernel state). Every error names its field."""
@@ -108,6 +118,7 @@ def start_trajectory(params, x0, v0, method, rtol, atol, section_phase=0.0, u0=N
     u = initial_u(params.model, x0, v0, u0)
     solver = Solver(method=method, rtol=rtol, atol=atol, model=params.model,
                     section_phase=section_phase)
+    check_admissible(solver, params, u)
     return params, solver, params.pack(), solver.opts(), state_from_u(u)
 
 
@@ -278,4 +289,4 @@ def simulate(params: ParamsBase, *, periods: int, transient: int = 0,
                                transient=transient, samples_per_period=spp,
                                **start_attrs(u_start), forcing_period=T),
     )
-    return ds
+    return apply_state_units(ds, params.model)

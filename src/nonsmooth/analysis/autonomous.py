@@ -37,7 +37,7 @@ import xarray as xr
 from .. import status as st
 from ..errors import IntegrationError, ParameterError
 from ..integrate.contract import ST_MODE
-from ..io import provenance_attrs
+from ..io import apply_state_units, provenance_attrs
 from ..kernels import Solver, output_buffers
 from ..models.base import KERNEL_GENERIC
 
@@ -181,9 +181,10 @@ class _Flow:
 
 
 def _start(params, solver, x0, v0, u0):
-    from ..simulate import initial_u, state_from_u
+    from ..simulate import check_admissible, initial_u, state_from_u
     from ..kernels import run
     u = initial_u(params.model, x0, v0, u0)
+    check_admissible(solver, params, u)
     s = state_from_u(u)
     run(KERNEL_GENERIC, solver.fns, params.pack(), solver.opts(), s, 1, 0, 0,
         *output_buffers(0))  # classify the mode without moving
@@ -361,7 +362,7 @@ def limit_cycle(params, section="V", *, x0: float = 0.0, v0: float = 0.0, u0=Non
     absmu = np.abs(mu)
     stable = bool(converged and absmu.size and np.all(absmu < 1.0 - 1e-6))
     t = np.arange(samples) * (period / samples) if converged else np.full(samples, np.nan)
-    return xr.Dataset(
+    ds = xr.Dataset(
         {
             "period": ((), period if converged else math.nan,
                        {"long_name": "period of the limit cycle", "units": "s"}),
@@ -391,6 +392,7 @@ def limit_cycle(params, section="V", *, x0: float = 0.0, v0: float = 0.0, u0=Non
                                verdict=("stable" if stable else "unstable") if converged
                                else "not found"),
     )
+    return apply_state_units(ds, params.model)
 
 
 def _on_section(params, solver, template, z):
@@ -812,7 +814,7 @@ def surface_basins(params, section="V", *, x=(-1.0, 1.0), v=(-1.0, 1.0), grid=20
     if na:
         lab_attrs.update(flag_values=np.arange(-1, na, dtype=np.int64),
                          flag_meanings=" ".join(["undecided"] + names))
-    return xr.Dataset(
+    ds = xr.Dataset(
         {
             "label": (("v0", "x0"), label, lab_attrs),
             "kind": ("attractor", np.array([f[0] for f in found], np.int8), flag_attrs(
@@ -835,3 +837,4 @@ def surface_basins(params, section="V", *, x=(-1.0, 1.0), v=(-1.0, 1.0), grid=20
                                transient=transient, record=record, max_period=max_period,
                                max_time=flow.max_time, u0=base),
     )
+    return apply_state_units(ds, params.model)

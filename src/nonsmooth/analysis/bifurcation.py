@@ -21,7 +21,7 @@ import xarray as xr
 
 from .. import status as st
 from ..errors import ParameterError
-from ..io import provenance_attrs
+from ..io import apply_state_units, provenance_attrs
 from ..integrate.contract import MODEL_FNS_TYPE
 from ..kernels import Solver, mode_holds, run
 from ..models.base import ParamsBase
@@ -529,7 +529,7 @@ def bifurcation_diagram(params: ParamsBase, param: str, values, *, sweep: str = 
     from ..sweep import progress_callback
     progress = progress_callback(progress, "bifurcation")
     from ..chunks import check_engine
-    from ..simulate import check_int, check_params, initial_u, start_attrs
+    from ..simulate import check_admissible, check_int, check_params, initial_u, start_attrs
     params = check_params(params)
     engine = check_engine(engine)
     if not isinstance(param, str):
@@ -544,6 +544,7 @@ def bifurcation_diagram(params: ParamsBase, param: str, values, *, sweep: str = 
     u = initial_u(params.model, x0, v0, u0)
     solver = Solver(model=params.model, method=method, rtol=rtol, atol=atol,
                     max_steps=max_steps, section_phase=section_phase)
+    check_admissible(solver, params, u)
     directions = {"up": ["up"], "down": ["down"], "both": ["up", "down"], "fresh": ["fresh"]}[sweep]
     from .stability import wants_lyapunov
     out = run_branches(params, param, values, solver, directions=directions,
@@ -603,4 +604,4 @@ def branches_dataset(params, param, values, solver, directions, out, **attrs) ->
     )
     ds.attrs["swept_param"] = param
     del ds.attrs[f"param_{param}"]  # swept: a coordinate, not a single value
-    return ds
+    return apply_state_units(ds, params.model)

@@ -32,7 +32,7 @@ import xarray as xr
 from .. import status as st
 from ..errors import ParameterError
 from ..integrate.roots import illinois_point, illinois_update
-from ..io import provenance_attrs
+from ..io import apply_state_units, provenance_attrs
 from ..kernels import output_buffers, run
 from ..models.base import KERNEL_GENERIC
 from ..simulate import (check_float, check_int, component_variables, start_trajectory,
@@ -476,7 +476,7 @@ def _dataset(params, solver, param, k, pts, specials, status, N, direction, boun
                                param=param, k=k, direction=direction, status=status,
                                bounds_low=float(bounds[0]), bounds_high=float(bounds[1])),
     )
-    return ds
+    return apply_state_units(ds, params.model)
 
 
 def two_parameter_curve(params, param: str, param2: str, values2, *, special: str = "fold",

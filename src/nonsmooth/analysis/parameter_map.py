@@ -136,7 +136,7 @@ def parameter_map(params: ParamsBase, x=("omega", 0.8, 1.0, 100), y=("F0", 0.15,
     progress = progress_callback(progress, "map")
     from ..chunks import Plan, check_engine, execute, plan_solver
     from ..io import check_memory
-    from ..simulate import check_int, check_params, initial_u, start_attrs
+    from ..simulate import check_admissible, check_int, check_params, initial_u, start_attrs
     from .poincare import settle_tolerance
     from .stability import wants_lyapunov
     params = check_params(params)
@@ -160,6 +160,7 @@ def parameter_map(params: ParamsBase, x=("omega", 0.8, 1.0, 100), y=("F0", 0.15,
                  size=(nx, 1))
     solver = Solver(model=params.model, method=method, rtol=rtol, atol=atol,
                     max_steps=max_steps, section_phase=section_phase)
+    check_admissible(solver, params, u)
     lyap = wants_lyapunov(lyapunov, solver)
     if chunk is not None:
         chunk = check_int("chunk", chunk, 1)
@@ -230,7 +231,8 @@ def _dataset(params, solver, xname, xs, yname, ys, out, attrs) -> xr.Dataset:
         attrs=provenance_attrs(params, solver, swept=(xname, yname), max_period=MAX_PERIOD,
                                n_failed=int(np.count_nonzero(out["status"])), **attrs),
     )
-    return ds
+    from ..io import apply_state_units
+    return apply_state_units(ds, params.model)
 
 
 def regimes(ds, max_shown: int = 8):

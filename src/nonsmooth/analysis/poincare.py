@@ -54,7 +54,7 @@ import xarray as xr
 from .. import status as st
 from ..errors import IntegrationError
 from ..integrate.contract import ST_MODE
-from ..io import provenance_attrs
+from ..io import apply_state_units, provenance_attrs
 from ..kernels import Solver, run
 from ..models.base import ParamsBase
 from .periodicity import (NOT_SETTLED, TOL_FACTOR, detect_period, section_tolerance,
@@ -378,4 +378,4 @@ def poincare(params: ParamsBase, *, record: int | None = None, transient: int, x
                                    rtol, atol, max(np.max(np.abs(X)), np.max(np.abs(V)))),
                                orbit_periods=n_orb, orbit_samples=orbit_samples),
     )
-    return ds
+    return apply_state_units(ds, params.model)

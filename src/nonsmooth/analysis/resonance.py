@@ -193,7 +193,8 @@ def resonance_curve(params: ParamsBase, omegas, *, method: str = "smooth", trans
     from ..sweep import progress_callback
     progress = progress_callback(progress, "resonance")
     from ..chunks import check_engine
-    from ..simulate import check_float, check_int, check_params, initial_u, start_attrs
+    from ..simulate import (check_admissible, check_float, check_int, check_params,
+                            initial_u, start_attrs)
     params = check_params(params)
     engine = check_engine(engine)
     transient = check_int("transient", transient, 0)
@@ -214,6 +215,7 @@ def resonance_curve(params: ParamsBase, omegas, *, method: str = "smooth", trans
         raise ParameterError(f"branches: expected 'stable' or 'all', got {branches!r}")
     solver = Solver(method=method, rtol=rtol, atol=atol,
                     model=params.model, section_phase=section_phase)
+    check_admissible(solver, params, u)
     out = run_branches(params, w_name, omegas, solver, directions=["up", "down"],
                        transient=transient, record=record, x0=u[0], v0=u[1], extra=u[2:],
                        settle=settle, workers=workers, progress=progress, store=store,

@@ -26,7 +26,7 @@ from .. import status as st
 from ..errors import IntegrationError, ParameterError
 from ..integrate.contract import ST_H, ST_MODE
 from ..integrate.hybrid import advance_tangent
-from ..io import check_memory, provenance_attrs
+from ..io import apply_state_units, check_memory, provenance_attrs
 from ..kernels import mode_holds, output_buffers, run
 from ..models.base import KERNEL_GENERIC
 from ..simulate import (check_float, check_int, component_variables, start_attrs,
@@ -395,7 +395,7 @@ def periodic_orbit(params, *, k: int = 1, x0: float = 0.0, v0: float = 0.0,
                                         else "unstable") if converged else "not found",
                                forcing_period=T),
     )
-    return ds
+    return apply_state_units(ds, params.model)
 
 
 def damped_step(z, dz, res, trial, halvings: int = 12):

@@ -213,7 +213,10 @@ class Method:
     ``OPT_VARIANT``; the generic kernel ignores it). ``continuous_memory``: the memory slots that are continuous functions of
     the state (e.g. an entry velocity), as opposed to discrete flags; tangent dynamics carry
     them, and ``jacobian`` must give the field's derivative with respect to slot i in column
-    n + i of J (J has n + n_memory columns, the memory ones zeroed before each call)."""
+    n + i of J (J has n + n_memory columns, the memory ones zeroed before each call).
+    ``admissible``: None, or a plain Python function ``admissible(u, params) -> bool`` telling
+    whether a state may start a trajectory (a ball above its table), with ``admissible_text``
+    saying what it requires; analyses refuse other starts in one line."""
 
     field: Callable
     jacobian: Callable
@@ -230,6 +233,8 @@ class Method:
     kernel: int = KERNEL_GENERIC
     continuous_memory: tuple = ()
     variant: int = 0
+    admissible: Callable | None = None
+    admissible_text: str = ""
 
 
 def _no_linear(mode, p, out):

@@ -59,6 +59,7 @@ MODEL = model_from_equations(
                                            (True, "flight", {"Z": "0", "V": "-r*V"})])],
                     "stuck": [Guard("g - A*omega**2*sin(omega*t)", "flight")]},
             initial=[(f"Z <= 0 and V <= 0 and {PRESSING}", "stuck")],
+            admissible="Z >= 0",
             description="Newton's impact law, chatter ending in sticking; RKF45 at rtol 1e-12 "
                         "in flight"),
         "smooth": dict(

@@ -140,7 +140,7 @@ def model_from_equations(name: str, *, states, parameters, modes: dict | None = 
     built = {}
     for mname, spec in methods.items():
         unknown = set(spec) - {"modes", "guards", "initial", "rtol", "atol", "description",
-                               "flow_is_homeomorphism"}
+                               "flow_is_homeomorphism", "admissible"}
         if unknown:
             raise bad(f"method {mname}: unknown key {sorted(unknown)[0]!r}")
         built[mname] = _method(sp, ctx, name, mname, spec, states, pnames, mode_names,
@@ -202,7 +202,24 @@ def _method(sp, ctx, name, mname, spec, states, pnames, mode_names, closed_form,
                   flow_is_homeomorphism=bool(spec.get("flow_is_homeomorphism", False)),
                   modes=tuple(mode_names.index(m) for m in own), rtol=rtol, atol=atol,
                   description=spec.get("description")
-                  or f"written as equations ({len(own)} modes)")
+                  or f"written as equations ({len(own)} modes)",
+                  **_admissible(sp, ctx, spec.get("admissible"), states, pnames, bad))
+
+
+def _admissible(sp, ctx, text, states, pnames, bad) -> dict:
+    """``admissible=`` of a method: a condition on the state and the parameters (no t) that
+    every start must meet, as Method(admissible=, admissible_text=)."""
+    if text is None:
+        return {}
+    cond = ctx.condition(text, "admissible")
+    if ctx.t in cond.free_symbols or ctx.C in cond.free_symbols or ctx.S in cond.free_symbols:
+        raise bad("admissible: a condition on the state and the parameters, without t")
+    args = [ctx.sym[k] for k in states] + [ctx.sym[k] for k in pnames]
+    test = sp.lambdify(args, cond, modules="math")
+
+    def admissible(u, params):
+        return bool(test(*(float(x) for x in u), *(float(getattr(params, k)) for k in pnames)))
+    return {"admissible": admissible, "admissible_text": str(text)}
 
 
 _STEPS: dict = {}

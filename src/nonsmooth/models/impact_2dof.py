@@ -73,6 +73,7 @@ MODEL = model_from_equations(
                                                  (True, "free", {"V": "-r*V"})])],
                     "stuck": [Guard(PRESS, "free")]},
             initial=[(f"X >= delta and V >= 0 and {PRESS} >= 0", "stuck")],
+            admissible="X <= delta",
             description="Newton's impact law at the stop, chatter ending in sticking; RKF45 "
                         "at rtol 1e-12 between impacts"),
         "smooth": dict(

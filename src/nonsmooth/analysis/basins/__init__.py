@@ -112,7 +112,8 @@ import xarray as xr
 
 from ...errors import ParameterError
 from ...integrate.contract import N_STATE
-from ...io import check_memory, flag_attrs, provenance_attrs, status_flags
+from ...io import (apply_state_units, check_memory, flag_attrs, provenance_attrs,
+                   status_flags)
 from ...kernels import Solver, new_state, output_buffers, run
 from ...models.base import ParamsBase
 from ...simulate import check_float, check_int, check_params
@@ -555,4 +556,4 @@ def _dataset(params, solver, xs, vs, label, used, status, found, key, kind, cont
             mean_periods_used=float(used.mean()), samples_per_period=spp,
             forcing_period=params.period, **extra),
     )
-    return ds
+    return apply_state_units(ds, params.model)

@@ -8,7 +8,7 @@ import math
 import numba as nb
 import numpy as np
 
-from ...integrate.contract import N_STATE, ST_H, ST_MODE, ST_V, ST_VA, ST_X
+from ...integrate.contract import N_STATE, ST_EXTRA, ST_H, ST_MODE, ST_V, ST_VA, ST_X
 from ...kernels import run
 from ...status import NON_FINITE
 
@@ -30,11 +30,15 @@ _N_REC = 5
 
 @nb.njit(cache=True, inline="always")
 def _init_state(state, x0, v0):
+    """``kernels.new_state(x0, v0)`` in place: the further state components and the memory
+    slots (``state[ST_EXTRA:]``) start at 0, whatever the (uninitialised) array held."""
     state[ST_X] = x0
     state[ST_V] = v0
     state[ST_VA] = v0
     state[ST_MODE] = -1.0
     state[ST_H] = 0.0
+    for i in range(ST_EXTRA, state.shape[0]):
+        state[i] = 0.0
 
 
 @nb.njit(cache=True, inline="always")
