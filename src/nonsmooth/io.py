@@ -298,11 +298,16 @@ _X_NAME = re.compile(r"(^|_)(X|x0)($|_)")
 _V_NAME = re.compile(r"(^|_)(V|v0)($|_)")
 
 
+def xv_units(model) -> tuple:
+    """The units of X and V: the model's ``state_units`` ("1", "1/s" where it names none)."""
+    return (tuple(model.state_units) + ("1", "1/s")[len(model.state_units):])[:2]
+
+
 def apply_state_units(ds, model):
     """The units of every variable and coordinate of ``ds`` holding X or V (``X``, ``max_X``,
     ``X_section``, ``orbit_V``, ``x0``, ...) from the model's ``state_units`` (the analyses
     write "1" and "1/s", the paper's dimensionless units); returns ``ds``."""
-    ux, uv = (tuple(model.state_units) + ("1", "1/s")[len(model.state_units):])[:2]
+    ux, uv = xv_units(model)
     for name in list(ds.data_vars) + list(ds.coords):
         if _X_NAME.search(str(name)):
             ds[name].attrs["units"] = ux

@@ -133,26 +133,14 @@ def start_attrs(u) -> dict:
     return {"x0": float(u[0]), "v0": float(u[1]), "u0": np.asarray(u, dtype=np.float64)}
 
 
-def xv_units(model) -> tuple:
-    """The units of X and V (the model's ``state_units``; "1", "1/s" where it names none)."""
-    u = tuple(model.state_units) + ("1", "1/s")[len(model.state_units):]
-    return u[0], u[1]
-
-
-def component_names(model) -> list[str]:
-    """The variable name of each state component of ``model`` in a result (see
-    ``io.component_names``)."""
-    from .io import component_names as names_of
-    return names_of(model.state_names)
-
-
 def component_variables(model, dims, U, prefix: str = "", suffix: str = "",
                         what: str = "") -> dict:
     """Dataset variables ``<prefix><name><suffix>`` of the components u[2:] of ``U`` (last
     axis: the components; X and V are written by each analysis), each with the model's units
     and long name (CF: one unit per variable)."""
+    from .io import component_names
     out = {}
-    names = component_names(model)
+    names = component_names(model.state_names)
     for i in range(2, model.n):
         units = model.state_units[i] if len(model.state_units) > i else "1"
         long = model.state_long_names[i] if len(model.state_long_names) > i else names[i]
@@ -256,7 +244,6 @@ def simulate(params: ParamsBase, *, periods: int, transient: int = 0,
     Xmin = np.concatenate([[state[0]], rec["Xmin"][0]])
     U = np.concatenate([state_u(params.model, state)[None, :], rec["U"][0]])
     T = params.period
-    ux, uv = xv_units(params.model)
     t0 = transient * T + solver.section_phase / getattr(params, params.model.omega)
     t = t0 + np.arange(n + 1) * (T / spp)
     modes = params.model.mode_names
@@ -265,8 +252,8 @@ def simulate(params: ParamsBase, *, periods: int, transient: int = 0,
     ds = xr.Dataset(
         {
             "X": ("t", X, {"long_name": "displacement X = x/g" if params.model.name == "support"
-                           else "displacement X", "units": ux}),
-            "V": ("t", V, {"long_name": "velocity dX/dt", "units": uv}),
+                           else "displacement X", "units": "1"}),
+            "V": ("t", V, {"long_name": "velocity dX/dt", "units": "1/s"}),
             "region": ("t", R, dict(regions, long_name="region of eq. 14 at t")),
             "visited": ("t", M, dict(masks, long_name="regions visited since the previous "
                                                       "sample")),

@@ -206,10 +206,11 @@ def _setup(params, section, method, rtol, atol, max_time, who):
 def _xv(model, dims, U, what: str, suffix: str = "") -> dict:
     """Variables of the state U (last axis: components): X, V and one per further component
     (``io.components`` assembles them)."""
+    from ..io import xv_units
     from ..simulate import component_variables
-    units = tuple(model.state_units) + ("1",) * model.n
-    return {f"X{suffix}": (dims, U[..., 0], {"long_name": f"X{what}", "units": units[0]}),
-            f"V{suffix}": (dims, U[..., 1], {"long_name": f"V{what}", "units": units[1]}),
+    ux, uv = xv_units(model)
+    return {f"X{suffix}": (dims, U[..., 0], {"long_name": f"X{what}", "units": ux}),
+            f"V{suffix}": (dims, U[..., 1], {"long_name": f"V{what}", "units": uv}),
             **component_variables(model, dims, U, suffix=suffix, what=what)}
 
 
@@ -294,7 +295,7 @@ def limit_cycle(params, section="V", *, x0: float = 0.0, v0: float = 0.0, u0=Non
     ``residual``. A converged cycle is integrated once more without tangents and must close on
     itself to ``CONFIRM_TOL``."""
     from ..simulate import check_float, check_int, start_attrs
-    from .stability import damped_step
+    from .stability import _section_state, damped_step
     params, solver, flow, text = _setup(params, section, method, rtol, atol, max_time,
                                         "limit_cycle")
     transient = check_int("transient", transient, 1)
@@ -332,7 +333,7 @@ def limit_cycle(params, section="V", *, x0: float = 0.0, v0: float = 0.0, u0=Non
                 status = "singular"
                 break
             def trial(zt):
-                st_t = _on_section(params, solver, s, zt)
+                st_t = _section_state(flow.setup, flow.p, zt, s)  # mode kept if it holds
                 s1t = st_t.copy()
                 got_t = flow.crossings(s1t, 1)[0]
                 return st_t, (float(np.linalg.norm(state_u(params.model, s1t) - zt))
@@ -342,6 +343,10 @@ def limit_cycle(params, section="V", *, x0: float = 0.0, v0: float = 0.0, u0=Non
                 status = "diverged"
                 break
             s = st_t
+    if s[ST_MODE] < 0:  # a Newton step's state whose mode was left to the kernel
+        from ..kernels import run
+        run(KERNEL_GENERIC, solver.fns, params.pack(), solver.opts(), s, 1, 0, 0,
+            *output_buffers(0))
     mu = np.linalg.eigvals(J) if J is not None and np.all(np.isfinite(J)) else np.array([])
     mu = mu[np.argsort(-np.abs(mu), kind="stable")]
     converged = status == "converged"
@@ -393,22 +398,6 @@ def limit_cycle(params, section="V", *, x0: float = 0.0, v0: float = 0.0, u0=Non
                                else "not found"),
     )
     return apply_state_units(ds, params.model)
-
-
-def _on_section(params, solver, template, z):
-    """A kernel state at z with the template's mode if it still holds there (else
-    classified)."""
-    from ..kernels import mode_holds, run
-    from ..tangent import TangentSetup
-    setup = TangentSetup(solver)
-    zz = np.zeros(setup.N)
-    zz[:params.model.n] = z
-    s = setup.state_of(zz, template)
-    p = params.pack()
-    if not mode_holds(KERNEL_GENERIC, setup.fns, p, setup.opts, s):
-        s[ST_MODE] = -1.0
-        run(KERNEL_GENERIC, setup.fns, p, setup.opts, s, 1, 0, 0, *output_buffers(0))
-    return s
 
 
 def _sample_cycle(params, solver, state, period, samples):

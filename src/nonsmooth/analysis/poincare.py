@@ -279,7 +279,7 @@ def poincare(params: ParamsBase, *, record: int | None = None, transient: int, x
     progress = progress_callback(progress, "poincare")
     from ..io import check_memory, flag_attrs, status_flags
     from ..simulate import (check_int, component_variables, renamed, start_attrs,
-                            start_trajectory, state_u, xv_units)
+                            start_trajectory, state_u)
     from ..sweep import run_trajectories
     from .bifurcation import follow, summarize
     record = renamed("record", record, "points", points)
@@ -331,7 +331,6 @@ def poincare(params: ParamsBase, *, record: int | None = None, transient: int, x
     oU = np.concatenate([state_u(params.model, state)[None, :], orb["U"][0]])
 
     T = params.period
-    ux, uv = xv_units(params.model)
     regions = flag_attrs(params.model.mode_names, dtype=np.int8)
     extra = {}
     from .stability import lyapunov_variables, wants_lyapunov
@@ -341,8 +340,8 @@ def poincare(params: ParamsBase, *, record: int | None = None, transient: int, x
     ts = solver.section_phase * T / (2.0 * np.pi)  # the section's time in a period
     ds = xr.Dataset(
         {
-            "X": ("n", X, {"long_name": "section displacement X(t_section)", "units": ux}),
-            "V": ("n", V, {"long_name": "section velocity dX/dt(t_section)", "units": uv}),
+            "X": ("n", X, {"long_name": "section displacement X(t_section)", "units": "1"}),
+            "V": ("n", V, {"long_name": "section velocity dX/dt(t_section)", "units": "1/s"}),
             "period": ((), np.int64(period), {"long_name": PERIOD_LONG_NAME, "units": "1"}),
             "max_X": ((), mx, {"long_name": "largest X over the recorded periods (interior "
                                             "extrema included)", "units": "1"}),
@@ -355,8 +354,8 @@ def poincare(params: ParamsBase, *, record: int | None = None, transient: int, x
             "transient_used": ((), np.int64(used), {
                 "long_name": "forcing periods integrated before the recorded window",
                 "units": "1"}),
-            "orbit_X": ("sample", oX, {"long_name": "phase-portrait displacement", "units": ux}),
-            "orbit_V": ("sample", oV, {"long_name": "phase-portrait velocity", "units": uv}),
+            "orbit_X": ("sample", oX, {"long_name": "phase-portrait displacement", "units": "1"}),
+            "orbit_V": ("sample", oV, {"long_name": "phase-portrait velocity", "units": "1/s"}),
             "orbit_region": ("sample", oR, dict(regions, long_name="region of eq. 14")),
             **component_variables(params.model, "n", U, what=" at the section"),
             **component_variables(params.model, "sample", oU, prefix="orbit_",

@@ -30,7 +30,7 @@ from ..io import apply_state_units, check_memory, provenance_attrs
 from ..kernels import mode_holds, output_buffers, run
 from ..models.base import KERNEL_GENERIC
 from ..simulate import (check_float, check_int, component_variables, start_attrs,
-                        start_trajectory, state_u, xv_units)
+                        start_trajectory, state_u)
 from ..tangent import TangentSetup, period_map
 
 #: Lyapunov verdicts (CF flag values of ``lyapunov_class``).
@@ -374,8 +374,8 @@ def periodic_orbit(params, *, k: int = 1, x0: float = 0.0, v0: float = 0.0,
                 "long_name": "fraction of the orbit's samples in contact modes", "units": "1"}),
             "X": ("t", X, {"long_name": params.model.state_long_names[0]
                            if params.model.state_long_names else "X",
-                           "units": xv_units(params.model)[0]}),
-            "V": ("t", V, {"long_name": "velocity dX/dt", "units": xv_units(params.model)[1]}),
+                           "units": "1"}),
+            "V": ("t", V, {"long_name": "velocity dX/dt", "units": "1/s"}),
             **component_variables(params.model, "point", U[::spp][:k], suffix="_section",
                                   what=" at the section t = jT"),
             **component_variables(params.model, "t", U),
