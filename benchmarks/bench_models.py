@@ -2,7 +2,7 @@
 scipy ``solve_ivp`` on the SAME model.
 
 For each built-in model (``support``, ``two_sided``, ``impact``, ``stick_slip``,
-``bouncing_ball``, ``impact_2dof``; a model whose module does not exist yet is skipped) and each method (``smooth``, ``exact``), one trajectory
+``bouncing_ball``, ``impact_2dof``, ``jeffcott_rotor``; a model whose module does not exist yet is skipped) and each method (``smooth``, ``exact``), one trajectory
 from X = V = 0:
 
 * nonsmooth: ``Solver(model=m, method=...)`` through ``kernels.run`` (the model's specialised
@@ -15,7 +15,8 @@ from X = V = 0:
   tuple, ~100x the field itself, which would inflate the ratios), so both sides integrate
   exactly the same vector fields, switching surfaces and transitions: integrate in a mode
   with the mode's guards as terminal events (g_k = G[k, :n] . u + G[k, n]
-  + G[k, n+1] cos(omega t) + G[k, n+2] sin(omega t), left when one turns negative), apply the
+  + G[k, n+1] cos(omega t) + G[k, n+2] sin(omega t), or the model's ``curved`` function for a
+  curved row, left when one turns negative), apply the
   model's transition at the located event, continue in the new mode. RK45 at rtol 1e-8,
   atol 1e-10 (as ours) for ``smooth``; DOP853 at rtol 1e-10, atol 1e-12 for ``exact``; tens of
   forcing periods.
@@ -64,6 +65,9 @@ CASES = (
      "Gamma = 1.3: the period-one orbit, one impact per period (free flight: RKF45)"),
     ("impact_2dof", lambda m: m.params(),
      "defaults: one impact per period, four states (RKF45 between impacts)"),
+    ("jeffcott_rotor", lambda m: m.preset("partial_rub"),
+     "partial_rub: two crossings of the clearance circle per turn (a curved guard), four "
+     "states"),
 )
 
 SCIPY = {"smooth": dict(method="RK45", rtol=1e-8, atol=1e-10),
@@ -108,16 +112,30 @@ def _field_caller(field_cfunc):
     return call
 
 
+def _curved_caller(curved_cfunc):
+    """An njit entry calling the model's compiled ``curved`` guard function."""
+    curved_cfunc = getattr(curved_cfunc, "cfunc", curved_cfunc)
+
+    @nb.njit
+    def call(mode, k, t, c, s, u, p, mem, grad):
+        return curved_cfunc(mode, k, t, c, s, u, p, mem, grad)
+
+    return call
+
+
 def propagation(model, params, method) -> str:
     """How the method's modes are propagated: closed form for those ``linear`` declares at
     these parameters, else the RKF45."""
     m = model.method(method)
     if not m.closed_form:
         return "RKF45"
-    fns, p, out = model.fns(method), params.pack(), np.zeros(4)
+    n = model.n
+    fns, p, out = model.fns(method), params.pack(), np.zeros(max(4, n * n + 3 * n))
     modes = m.modes or tuple(range(len(model.mode_names)))
-    closed = [model.mode_names[k] for k in modes if call_linear(fns, k, p, out)]
-    return f"closed form in {'/'.join(closed)}" if closed else "RKF45 (no linear mode)"
+    kinds = {1: "oscillator", 2: "series"}
+    closed = [f"{model.mode_names[k]} ({kinds[r]})" for k in modes
+              if (r := int(call_linear(fns, k, p, out))) in kinds]
+    return f"closed form in {', '.join(closed)}" if closed else "RKF45 (no linear mode)"
 
 
 class SameModel:
@@ -133,6 +151,16 @@ class SameModel:
         self.du = np.zeros(self.n)
         self.call_field = _field_caller(self.fns[0])
         self.call_field(0, 0.0, 1.0, 0.0, np.zeros(self.n), self.p, self.mem, self.du)  # compile
+        self.call_curved = _curved_caller(self.fns[6])
+        self.grad = np.zeros(self.n + 1)
+
+    def guard(self, mode, k, row, t, u):
+        """Guard k (``row`` of G) at (t, u): affine, or the model's curved function."""
+        n, om = self.n, self.om
+        c, s = math.cos(om * t), math.sin(om * t)
+        if math.isnan(row[n]):
+            return float(self.call_curved(mode, k, t, c, s, u, self.p, self.mem, self.grad))
+        return float(row[:n] @ u[:n] + row[n] + row[n + 1] * c + row[n + 2] * s)
 
     def field(self, mode):
         p, mem, du, om, call_field = self.p, self.mem, self.du, self.om, self.call_field
@@ -154,6 +182,17 @@ class SameModel:
         n, om = self.n, self.om
         out = []
         for k in range(ng):
+            if math.isnan(rows[k, n]):  # a curved guard: from 0 if a round-off below
+                g0 = self.guard(mode, k, rows[k], t0, u0)
+                shift = -min(g0, 0.0) + 1e-14 * max(abs(g0), 1e-300)
+
+                def gc(t, u, k=k, row=rows[k], shift=shift):
+                    return self.guard(mode, k, row, t, u) + shift
+
+                gc.terminal = True
+                gc.direction = -1
+                out.append(gc)
+                continue
             a, b, cc, ss = rows[k, :n], rows[k, n], rows[k, n + 1], rows[k, n + 2]
             g0 = float(a @ u0[:n] + b + cc * math.cos(om * t0) + ss * math.sin(om * t0))
             scale = float(np.abs(a) @ np.abs(u0[:n]) + abs(b) + abs(cc) + abs(ss))
@@ -176,8 +215,12 @@ class SameModel:
         f = self.field(mode)(t, u)
         for k in range(ng):
             row = self.G[k]
-            g = row[:n] @ u + row[n] + row[n + 1] * c + row[n + 2] * s
-            dg = row[:n] @ f - row[n + 1] * om * s + row[n + 2] * om * c
+            if math.isnan(row[n]):
+                g = self.guard(mode, k, row, t, u)
+                dg = float(self.grad[:n] @ f + self.grad[n])
+            else:
+                g = row[:n] @ u + row[n] + row[n + 1] * c + row[n + 2] * s
+                dg = row[:n] @ f - row[n + 1] * om * s + row[n + 2] * om * c
             if g <= 0.0 and dg < 0.0:
                 return k
         return -1

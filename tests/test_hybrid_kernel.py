@@ -31,7 +31,7 @@ from nonsmooth.integrate.hybrid import advance_generic  # noqa: E402
 
 pytestmark = pytest.mark.filterwarnings("ignore::numba.NumbaExperimentalFeatureWarning")
 
-FIELD, JAC, GUARDS, TRANS, INIT, LIN = MODEL_SIGNATURES
+FIELD, JAC, GUARDS, TRANS, INIT, LIN, CURVED = MODEL_SIGNATURES
 
 # ---- toy models; p = (w0, xi, F0, omega, r, b) ----------------------------------------------
 P_W0, P_XI, P_F0, P_OM, P_R, P_B = range(6)
@@ -148,10 +148,72 @@ def sw_linear(mode, p, out):
     return 1
 
 
-LINEAR = (osc_field, no_jac, no_guards, impact, init_free, osc_linear)
-IMPACT = (osc_field, no_jac, stop_guard, impact, init_free, osc_linear)
-SWITCH = (sw_field, no_jac, sw_guards, sw_trans, sw_init, sw_linear)
-STUCK = (osc_field, no_jac, stop_guard, stuck, init_free, osc_linear)
+@nb.cfunc(CURVED, cache=False)
+def no_curved(mode, k, t, c, s, u, p, mem, grad):
+    return math.nan
+
+
+@nb.cfunc(LIN, cache=False)
+def osc_linear_general(mode, p, out):
+    """The same oscillator in the general form (``linmodes``): u' = A u + b + f_c cos, any n
+    (u[2:] decay as dz/dt = -z)."""
+    n = int(round(math.sqrt(out.shape[0] + 2.25) - 1.5))  # len(out) = n^2 + 3n
+    for i in range(out.shape[0]):
+        out[i] = 0.0
+    out[1] = 1.0
+    out[n] = -p[0] * p[0]
+    out[n + 1] = -p[1]
+    for i in range(2, n):
+        out[i * n + i] = -1.0
+    out[n * n + 1] = p[5]
+    out[n * n + n + 1] = p[2]
+    return 2
+
+
+LINEAR = (osc_field, no_jac, no_guards, impact, init_free, osc_linear, no_curved)
+IMPACT = (osc_field, no_jac, stop_guard, impact, init_free, osc_linear, no_curved)
+SWITCH = (sw_field, no_jac, sw_guards, sw_trans, sw_init, sw_linear, no_curved)
+STUCK = (osc_field, no_jac, stop_guard, stuck, init_free, osc_linear, no_curved)
+
+
+# a curved guard: the phase-plane disc (X - 2)^2 + V^2 <= rho^2 (rho = p[P_R]);
+# mode 0 outside it, mode 1 inside; each crossing time is stored in mem[1:], mem[0] counts
+_DISC_A = 2.0
+
+
+@nb.cfunc(GUARDS, cache=False)
+def disc_guards(mode, p, mem, G):
+    n = G.shape[1] - 3
+    for i in range(G.shape[1]):
+        G[0, i] = 0.0
+    G[0, n] = math.nan  # curved
+    return 1
+
+
+@nb.cfunc(CURVED, cache=False)
+def disc_curved(mode, k, t, c, s, u, p, mem, grad):
+    rho = p[P_R]
+    sg = 1.0 if mode == 0 else -1.0  # >= 0 outside the disc in mode 0, inside in mode 1
+    dx = u[0] - _DISC_A
+    grad[0] = sg * 2.0 * dx
+    grad[1] = sg * 2.0 * u[1]
+    for i in range(2, grad.shape[0]):
+        grad[i] = 0.0
+    return sg * (dx * dx + u[1] * u[1] - rho * rho)
+
+
+@nb.cfunc(TRANS, cache=False)
+def disc_trans(mode, k, t, c, s, u, p, mem):
+    i = int(mem[0])
+    if i + 1 < mem.shape[0]:
+        mem[i + 1] = t
+    mem[0] = i + 1.0
+    return 1 - mode
+
+
+DISC = (osc_field, no_jac, disc_guards, disc_trans, init_free, osc_linear, disc_curved)
+LINEAR_G = (osc_field, no_jac, no_guards, impact, init_free, osc_linear_general, no_curved)
+IMPACT_G = (osc_field, no_jac, stop_guard, impact, init_free, osc_linear_general, no_curved)
 
 
 def make_opts(rtol=1e-10, atol=1e-12, n=2, nmem=0, closed=False, max_steps=100_000):
@@ -274,19 +336,20 @@ def _scipy_impacts(p, X0, V0, t_end):
     return times, states, np.array(y0)
 
 
-@pytest.mark.parametrize("closed", [False, True])
+@pytest.mark.parametrize("closed", [False, True, "general"])
 def test_impact_oscillator_vs_scipy(closed):
     p = params(w0=1.0, xi=0.05, F0=1.0, om=0.8, r=0.8)
     T = 2 * math.pi / p[P_OM]
     n_per = 5
     times, states, y_end = _scipy_impacts(p, 0.0, 0.0, n_per * T)
     assert len(times) >= 3
-    opts = make_opts(rtol=1e-11, atol=1e-13, nmem=10, closed=closed)
+    opts = make_opts(rtol=1e-11, atol=1e-13, nmem=10, closed=bool(closed))
+    fns = IMPACT_G if closed == "general" else IMPACT
     state = make_state(0.0, 0.0, mem=(0.0,) * 10)
     got = []
     for k in range(n_per):  # one period per call, impact times from the model's memory
         state[ST_EXTRA:ST_EXTRA + 10] = 0.0
-        code, X, V, R, M, Xmax, Xmin = run(IMPACT, p, opts, state)
+        code, X, V, R, M, Xmax, Xmin = run(fns, p, opts, state)
         assert code == st.OK
         got += [k * T + state[ST_EXTRA + 1 + i] for i in range(int(state[ST_EXTRA]))]
         assert Xmax[0] <= 1.0 + 1e-9  # Hermite extrema: interpolation error ~ tolerance
@@ -295,7 +358,7 @@ def test_impact_oscillator_vs_scipy(closed):
     assert abs(state[ST_X] - y_end[0]) < 1e-7 and abs(state[ST_V] - y_end[1]) < 1e-7
 
 
-@pytest.mark.parametrize("closed,tol", [(False, 1e-4), (True, 1e-9)])
+@pytest.mark.parametrize("closed,tol", [(False, 1e-4), (True, 1e-9), ("general", 1e-9)])
 def test_dip_inside_a_closed_form_piece_is_not_missed(closed, tol):
     """X = A cos(t - 0.15), unforced, rises 1e-6 above the stop at X = 1 inside the first
     closed-form piece [0, 0.7]. The cubic Hermite of (g, g') over that piece has its minimum
@@ -305,9 +368,10 @@ def test_dip_inside_a_closed_form_piece_is_not_missed(closed, tol):
     magnified by the grazing slope)."""
     A = 1.0 + 1e-6
     p = params(w0=1.0, xi=0.0, F0=0.0, om=0.5, r=0.8)
-    opts = make_opts(rtol=1e-11, atol=1e-13, nmem=3, closed=closed)
+    opts = make_opts(rtol=1e-11, atol=1e-13, nmem=3, closed=bool(closed))
     state = make_state(A * math.cos(0.15), A * math.sin(0.15), mem=(0.0,) * 3)
-    code, X, V, R, M, Xmax, Xmin = run(IMPACT, p, opts, state)
+    code, X, V, R, M, Xmax, Xmin = run(IMPACT_G if closed == "general" else IMPACT, p, opts,
+                                       state)
     assert code == st.OK
     assert state[ST_EXTRA] >= 1  # impacts counted
     assert abs(state[ST_EXTRA + 1] - (0.15 - math.acos(1.0 / A))) < tol
@@ -369,3 +433,82 @@ def test_workspace_views_write_through_without_owning():
     assert fill(ws, Y) == (24, 8, 0.0)
     assert ws.tolist() == [0, 0, 1, 1, 1, 0, 0, 0, 0, 0, 7, 0]
     assert Y[0, 1] == 5.0
+
+
+@nb.cfunc(TRANS, cache=False)
+def disc_trans_state(mode, k, t, c, s, u, p, mem):
+    """As ``disc_trans``, storing (t, X, V) of each crossing."""
+    i = int(mem[0])
+    if 3 * i + 3 < mem.shape[0]:
+        mem[3 * i + 1] = t
+        mem[3 * i + 2] = u[0]
+        mem[3 * i + 3] = u[1]
+    mem[0] = i + 1.0
+    return 1 - mode
+
+
+DISC_STATE = (osc_field, no_jac, disc_guards, disc_trans_state, init_free, osc_linear,
+              disc_curved)
+
+
+@pytest.mark.parametrize("depth", [1e-3, 1e-6, 1e-9])
+@pytest.mark.parametrize("per_period", [1, 16])
+def test_curved_guard_crossing_times_and_grazing(depth, per_period):
+    """X'' + X = 0 from (0, 1): the orbit X = sin t, V = cos t (radius 1) dips into the disc of
+    radius rho = 1 + depth about (2, 0) around t = pi/2 (a near-grazing touch, the dip lasts
+    about 2 sqrt(depth), far less than a step): it enters where sin t = (5 - rho^2) / 4 and
+    leaves at pi minus that. Whatever the output sampling, both crossings are found, the state
+    at each is on the curved surface to 1e-12 (located on the true g), and the crossing times
+    agree with the closed form up to the integration's state error divided by the crossing
+    speed (about 4 sqrt(2 depth)): |dt| sqrt(depth) < 1e-11."""
+    rho = 1.0 + depth
+    p = params(w0=1.0, xi=0.0, F0=0.0, om=1.0, r=rho)
+    opts = make_opts(rtol=1e-12, atol=1e-14, nmem=10)
+    state = make_state(0.0, 1.0, mem=(0.0,) * 10)
+    code, X, *_ = run(DISC_STATE, p, opts, state, per_period=per_period, n_out=per_period)
+    assert code == st.OK
+    mem = state[ST_EXTRA:ST_EXTRA + 10]
+    assert mem[0] == 2  # in and out
+    t_in = math.asin((5.0 - rho * rho) / 4.0)
+    for i, want in enumerate((t_in, math.pi - t_in)):
+        t, x, v = mem[3 * i + 1:3 * i + 4]
+        assert abs((x - _DISC_A) ** 2 + v * v - rho * rho) < 1e-12
+        assert abs(t - want) * math.sqrt(depth) < 1e-11
+    assert abs(X[-1] - math.sin(2 * math.pi)) < 1e-9
+
+
+def test_curved_guard_missed_dip_is_absent():
+    """A disc the orbit does not reach (rho = 1 - 1e-6): no crossing at all."""
+    p = params(w0=1.0, xi=0.0, F0=0.0, om=1.0, r=1.0 - 1e-6)
+    state = make_state(0.0, 1.0, mem=(0.0,) * 3)
+    code, *_ = run(DISC, p, make_opts(rtol=1e-10, atol=1e-12, nmem=3), state, n_out=5)
+    assert code == st.OK and state[ST_EXTRA] == 0
+
+
+def test_general_linear_modes_in_closed_form():
+    """Linear modes in the general form (``linmodes``: the series of the augmented matrix
+    exponential) against closed forms: the forced oscillator's steady state (as the
+    oscillator's own closed form), free flight under a constant force with harmonic forcing
+    (A singular: X = X0 + V0 t + b t^2 / 2 + F0 (1 - cos t)), and an extra component decaying
+    as exp(-t), all to round-off; the piece count does not depend on the output sampling."""
+    p = params(xi=0.6)
+    X0, V0, a = steady(p)
+    state = make_state(X0, V0)
+    code, X, V, R, M, Xmax, Xmin = run(LINEAR_G, p, make_opts(closed=True), state, n_out=20)
+    assert code == st.OK
+    assert np.max(np.abs(X - X0)) < 1e-12 and np.max(np.abs(V - V0)) < 1e-12
+    assert abs(Xmax.max() - a) < 1e-12 and abs(Xmin.min() + a) < 1e-12
+    # free flight: w0 = xi = 0, X'' = F0 cos t + b
+    F0, b, X0, V0 = 0.7, -1.0, 0.3, 2.0
+    p = params(w0=0.0, xi=0.0, F0=F0, om=1.0, b=b)
+    for per_period in (1, 16):
+        state = make_state(X0, V0, extra=(1.0,))
+        code, X, V, *_ = run(LINEAR_G, p, make_opts(closed=True, n=3), state,
+                             per_period=per_period, n_out=3 * per_period)
+        assert code == st.OK
+        t = 2 * math.pi * np.arange(1, 4)
+        want = X0 + V0 * t + 0.5 * b * t ** 2 + F0 * (1 - np.cos(t))
+        got = X[per_period - 1::per_period]
+        assert np.max(np.abs(got - want)) < 1e-12 * np.abs(want).max()
+        assert abs(V[-1] - (V0 + b * t[-1])) < 1e-12 * abs(V0 + b * t[-1])
+        assert abs(state[ST_EXTRA] - math.exp(-t[-1])) < 1e-13 * math.exp(-t[-1])

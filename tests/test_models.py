@@ -12,7 +12,8 @@ from nonsmooth import status as st
 from nonsmooth.errors import ParameterError
 from nonsmooth.kernels import Solver, new_state, output_buffers, run
 
-BUILTIN = ("support", "two_sided", "impact", "stick_slip", "bouncing_ball", "impact_2dof")
+BUILTIN = ("support", "two_sided", "impact", "stick_slip", "bouncing_ball", "impact_2dof",
+           "jeffcott_rotor")
 
 #: parameters where each model switches every period (and settles quickly)
 CASES = {
@@ -22,6 +23,7 @@ CASES = {
     "stick_slip": dict(xi=0.05, F0=0.5, omega=0.8),
     "bouncing_ball": dict(A=1.3 / (4 * math.pi ** 2)),
     "impact_2dof": dict(),
+    "jeffcott_rotor": dict(e=0.1, g=0.5),  # partial rub, period one
 }
 
 #: a small window of initial conditions around each model's motion, for basins
@@ -32,6 +34,7 @@ WINDOWS = {
     "stick_slip": ((-1.0, 1.5), (-0.5, 0.5)),
     "bouncing_ball": ((0.0, 0.2), (-0.5, 0.5)),
     "impact_2dof": ((-1.0, 0.4), (-1.0, 1.0)),
+    "jeffcott_rotor": ((-1.5, 1.5), (-1.5, 1.5)),
 }
 
 

@@ -49,6 +49,8 @@ def _cases():
     yield "stick_slip stribeck preset", ss.preset("stribeck"), ("smooth", "exact"), 30
     yield "stick_slip issue 20", ss.params(**STRIBECK), ("smooth", "exact"), 40
     yield "impact_2dof", ns.model("impact_2dof").params(), ("smooth", "exact"), 20  # 4 states
+    rotor = ns.model("jeffcott_rotor")  # a curved guard, crossed twice per turn
+    yield "jeffcott_rotor", rotor.preset("intermittent"), ("smooth", "exact"), 12
     user = ns.model("examples/one_sided_duffing.py:MODEL")
     yield "one_sided_duffing", user.params(k_s=50.0), ("smooth", "exact"), 20
 

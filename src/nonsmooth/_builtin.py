@@ -10,6 +10,7 @@ BUILTIN = {
     "stick_slip": "nonsmooth.models.stick_slip",
     "bouncing_ball": "nonsmooth.models.bouncing_ball",
     "impact_2dof": "nonsmooth.models.impact_2dof",
+    "jeffcott_rotor": "nonsmooth.models.jeffcott_rotor",
 }
 
 #: The model a command uses when none is named: the paper's.

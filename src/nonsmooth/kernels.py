@@ -99,10 +99,14 @@ def mode_holds(kernel, fns, p, opts, state):
     psi = opts[OPT_PHASE]  # t = t_s: the forcing phase of the section
     c = math.cos(psi)
     s = math.sin(psi)
+    grad = np.empty(n + 1)
     for k in range(ng):
-        g = G[k, n] + G[k, n + 1] * c + G[k, n + 2] * s
-        for i in range(n):
-            g += G[k, i] * u[i]
+        if math.isnan(G[k, n]):  # a curved guard (``curved_row``)
+            g = fns[6](mode, k, psi / pp[int(opts[OPT_OMEGA])], c, s, u, pp, mem, grad)
+        else:
+            g = G[k, n] + G[k, n + 1] * c + G[k, n + 2] * s
+            for i in range(n):
+                g += G[k, i] * u[i]
         if g < 0.0:
             return False
     return True

@@ -46,6 +46,10 @@ N_STATE = 16  # so n - 2 + n_mem <= N_STATE - ST_EXTRA = 11
 #: Largest number of switching surfaces (guards) one mode may watch.
 MAX_GUARDS = 8
 
+#: A guard row whose constant column ``G[k, n]`` holds NaN is a *curved* guard: the kernel
+#: evaluates it, with its gradient, by the model's ``curved(mode, k, t, c, s, u, p, mem, grad)``
+#: (``models.base.curved_row`` writes such a row); every other row is affine.
+
 
 def _quiet_first_class_functions():
     """First-class functions are "experimental" in numba, and numba warns each time it types a
@@ -86,7 +90,8 @@ def _model_signatures():
     transition = i8(i8, i8, f8, f8, f8, a1, a1, a1)
     initial = i8(f8, f8, a1, a1, a1)
     linear = i8(i8, a1, a1)
-    sigs = (field, jacobian, guards, transition, initial, linear)
+    curved = f8(i8, i8, f8, f8, f8, a1, a1, a1, a1)
+    sigs = (field, jacobian, guards, transition, initial, linear, curved)
     return sigs, t.Tuple(tuple(t.FunctionType(s) for s in sigs))
 
 
@@ -125,7 +130,8 @@ def _register_typeof():
 #: numba signatures of a model's compiled functions (see ``nonsmooth.models.base``), in the
 #: order of the tuple ``fns`` that the generic kernel receives, and the type of that tuple.
 MODEL_SIGNATURES, MODEL_FNS_TYPE = _model_signatures()
-FIELD_SIG, JACOBIAN_SIG, GUARDS_SIG, TRANSITION_SIG, INITIAL_SIG, LINEAR_SIG = MODEL_SIGNATURES
+(FIELD_SIG, JACOBIAN_SIG, GUARDS_SIG, TRANSITION_SIG, INITIAL_SIG, LINEAR_SIG,
+ CURVED_SIG) = MODEL_SIGNATURES
 _register_typeof()
 
 

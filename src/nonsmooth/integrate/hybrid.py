@@ -1,7 +1,8 @@
 """Generic compiled kernel for hybrid (piecewise-smooth, event-driven) forced oscillators.
 
 Implements the kernel contract of :mod:`nonsmooth.integrate.contract` for any model given as
-the tuple of compiled functions ``fns = (field, jacobian, guards, transition, initial, linear)``
+the tuple of compiled functions
+``fns = (field, jacobian, guards, transition, initial, linear, curved)``
 (signatures ``contract.MODEL_SIGNATURES``); nothing here knows a particular model.
 
 Design summary
@@ -17,6 +18,13 @@ Design summary
   retaken exactly up to it, and ``transition`` (reset, new mode) is applied there; no FSAL
   across a switch. A guard with g <= 0 and g' < 0 at a step start triggers its transition at
   once; more than ``ZENO_MAX`` consecutive transitions each < ``ZENO_DT`` T apart -> ZENO.
+* A curved guard (a row marked by NaN in its constant column, ``models.curved_row``) is
+  evaluated with its gradient by the model's ``curved`` function on the same interpolant
+  (``_curved_exit``): ends that clear zero by twice the Hermite slope bound pass at once;
+  otherwise the step is halved left to right until each piece's Hermite of (g, g'), less an
+  error bound estimated from the true g at its midpoint, clears zero, so grazing dips are
+  found; the crossing is located by Illinois on the true g. Its gradient enters the saltation
+  matrix. A mode with a curved guard is never taken in closed form.
 * A guard with forcing terms (G[k, n+1], G[k, n+2]) is not a cubic along a step, and a step can
   be long (a stick phase has a zero error estimate, so its RKF45 steps grow to a whole output
   interval): its exit test is certified, and so is every guard on a closed-form piece (the
@@ -81,6 +89,8 @@ from .pwlinear import (BD_D2, BD_D3, BD_D4, BD_R, EXCLUDED, HERM_ERR, MC_A,  # n
                        MC_K, MC_LMAX, N_BD, N_MC, accel, apply_propagator, classify,
                        energy_norm, eval_state, functional_bounds, herm_coeffs, hom_part, jerk,
                        mode_coeffs, propagator)
+from .linmodes import (N_TAYLOR, THETA_POLY, guard_poly, lin_matrix, poly_component,  # noqa: E402
+                       poly_exit, poly_state, poly_tangent, poly_x_extrema, taylor_terms)
 from .record import record_interval  # noqa: E402
 from .roots import illinois_point, illinois_update, quad_roots01  # noqa: E402
 from .rkstep import (_A, _B, _C, _E, _FM, _NS, _control, _cubic, _shrink,  # noqa: E402
@@ -100,6 +110,7 @@ _MC_UNKNOWN = 0
 _MC_CLOSED = 1
 _MC_RK = 2
 _MC_RESONANT = 3
+_MC_POLY = 4  # a linear mode of any dimension: the series of exp(M s) (``linmodes``)
 
 # log2(m) on [0.5, 1), least-squares quartic (same as rkf45.pow_fast)
 @nb.njit(cache=True, inline="always")
@@ -363,19 +374,24 @@ def _locate(cf, lo, hi, glo, ghi, G, k, n, q0, q1, q2, q3, C, S, om, hs, MC, mod
     return lo, hi
 
 @nb.njit(cache=True)
-def _mode_class(linear, closed, mode, pp, lin, MC, mcs, om, MF):
-    """_MC_CLOSED / _MC_RK / _MC_RESONANT for ``mode``, filling the table row (and the forcing
-    amplitude ``MF[mode]``) lazily."""
+def _mode_class(linear, closed, mode, pp, lin, MC, mcs, om, MF, n, MX, MXR):
+    """_MC_CLOSED / _MC_RK / _MC_RESONANT / _MC_POLY for ``mode``, filling the table row (and
+    the forcing amplitude ``MF[mode]``, or the augmented matrix ``MX[mode]`` and its rate
+    ``MXR[mode]``) lazily."""
     if not closed:
         return _MC_RK
     if mcs[mode] == _MC_UNKNOWN:
         mcs[mode] = _MC_RK
-        if linear(mode, pp, lin) == 1 and lin[0] > 0.0:
+        r = linear(mode, pp, lin)
+        if r == 1 and n == 2 and lin[0] > 0.0:
             MF[mode] = lin[3]
             if mode_coeffs(lin[0], lin[1], lin[2], lin[3], om, THETA, MC[mode]):
                 mcs[mode] = _MC_CLOSED
             else:
                 mcs[mode] = _MC_RESONANT
+        elif r == 2:
+            MXR[mode] = lin_matrix(lin, n, om, MX[mode])
+            mcs[mode] = _MC_POLY
     return int(mcs[mode])
 
 
@@ -420,6 +436,200 @@ def _first_crossing(cf, lo, hi, g0, d0, u, f0, C, S, G, k, n, q0, q1, q2, q3, om
         lo, hi = _locate(cf, 0.0, sf, g0, gf, G, k, n, q0, q1, q2, q3, C, S, om, hs, MC, mode,
                          y0, z0)
     return lo, hi
+
+
+# ---- curved guards (``contract``: NaN in a row's constant column) ------------------------------
+CURVED_DEPTH = 12  # halvings of a step in the exit test of a curved guard
+
+
+@nb.njit(cache=True)
+def _curved_rate(curved, mode, k, tau, C, S, n, u, f, pp, mem, gr):
+    """(g, dg/dt) of curved guard k at (tau, u) moving with du/dt = f; gr <- its gradient."""
+    g = curved(mode, k, tau, C, S, u, pp, mem, gr)
+    d = gr[n]
+    for i in range(n):
+        d += gr[i] * f[i]
+    return g, d
+
+
+@nb.njit(cache=True)
+def _curved_at(curved, mode, k, tau, C, S, hs, om, n, u, f0, u1, f1, pp, mem, gr, us, s,
+               pm, TW):
+    """(g, dg/dt) of curved guard k at the fraction s of the step (tau, u) -> (tau + hs, u1),
+    on the step's cubic Hermite state interpolant (``us`` <- that state) with exact forcing;
+    on a piece of a linear mode (``pm``), on its series (exact)."""
+    th = om * (s * hs)
+    if pm:
+        poly_state(TW, n, s * hs, us)
+        g = curved(mode, k, tau + s * hs, C * math.cos(th) - S * math.sin(th),
+                   S * math.cos(th) + C * math.sin(th), us, pp, mem, gr)
+        d = gr[n]
+        for i in range(n):
+            d += gr[i] * poly_component(TW, i, s * hs)[1]
+        return g, d
+    for i in range(n):
+        du = u1[i] - u[i]
+        a = hs * f0[i]
+        b = 3.0 * du - 2.0 * a - hs * f1[i]
+        c = -2.0 * du + a + hs * f1[i]
+        us[i] = u[i] + s * (a + s * (b + s * c))
+    cs = math.cos(th)
+    sn = math.sin(th)
+    g = curved(mode, k, tau + s * hs, C * cs - S * sn, S * cs + C * sn, us, pp, mem, gr)
+    d = gr[n]
+    for i in range(n):
+        du = u1[i] - u[i]
+        a = hs * f0[i]
+        b = 3.0 * du - 2.0 * a - hs * f1[i]
+        c = -2.0 * du + a + hs * f1[i]
+        d += gr[i] * (a + s * (2.0 * b + 3.0 * s * c)) / hs
+    return g, d
+
+
+@nb.njit(cache=True)
+def _immediate_exit_curved(curved, mode, tau, G, ng, n, u, f0, C, S, om, pp, mem, gr):
+    """``_immediate_exit`` for a mode with curved guards."""
+    for k in range(ng):
+        if math.isnan(G[k, n]):
+            g, d = _curved_rate(curved, mode, k, tau, C, S, n, u, f0, pp, mem, gr)
+        else:
+            g = _gval(G, k, n, u, C, S)
+            d = _dgval(G, k, n, f0, C, S, om)
+        if g <= 0.0 and d < 0.0:
+            return k
+    return -1
+
+
+@nb.njit(cache=True)
+def _curved_exit(curved, mode, k, tau, C, S, hs, om, n, u, f0, u1, f1, pp, mem, gr, us, stack,
+                 s_best, pm, TW):
+    """Exit test of curved guard k over the step just taken: (lo, hi) bracketing its first
+    crossing to S_TOL of the step (g(lo) >= 0 > g(hi)), (2.0, 2.0) when it stays >= 0 up to
+    ``s_best`` (an earlier crossing of another guard), (-1.0, -1.0) when location fails.
+
+    A step whose ends clear zero by twice the Hermite slope bound is passed at once. Otherwise
+    pieces are taken left to right: a piece passes when the cubic Hermite of (g, g') at its
+    ends, less four times the quartic error bound estimated from the true g at its midpoint,
+    stays >= 0 (``_herm_clear``); else it is halved (at most CURVED_DEPTH times). On a piece
+    whose end is negative, the Hermite's interior minima are evaluated too, so the crossing
+    found is the first one, grazing dips included."""
+    g0, d0 = _curved_rate(curved, mode, k, tau, C, S, n, u, f0, pp, mem, gr)
+    g0 = max(g0, 0.0)  # round-off after the switch into this mode
+    g1, d1 = _curved_at(curved, mode, k, tau, C, S, hs, om, n, u, f0, u1, f1, pp, mem, gr, us,
+                        1.0, pm, TW)
+    sl = hs * (abs(d0) + abs(d1))
+    if g1 >= 0.0 and min(g0, g1) - 2.0 * _HERM_SLOPE * sl > 1e-9 * (abs(g0) + abs(g1) + sl):
+        return 2.0, 2.0
+    a = 0.0
+    b = 1.0
+    ga, da, gb, db = g0, d0, g1, d1
+    depth = 0
+    top = 0
+    lo = 2.0
+    hi = 2.0
+    ghi = 0.0
+    while True:
+        if a >= s_best:
+            return 2.0, 2.0
+        L = (b - a) * hs
+        if gb < 0.0:
+            lo = a
+            hi = b
+            ghi = gb
+            b1, b2, b3 = herm_coeffs(ga, da, gb, db, L)
+            r1, r2 = quad_roots01(b1, 2.0 * b2, 3.0 * b3)
+            for q in (min(r1, r2), max(r1, r2)):
+                if 0.0 < q < 1.0 and 2.0 * b2 + 6.0 * b3 * q > 0.0:  # a minimum
+                    sq = a + q * (b - a)
+                    gq, _ = _curved_at(curved, mode, k, tau, C, S, hs, om, n, u, f0, u1, f1,
+                                       pp, mem, gr, us, sq, pm, TW)
+                    if gq < 0.0:
+                        hi = sq
+                        ghi = gq
+                        break
+            break
+        m = 0.5 * (a + b)
+        gm, dm = _curved_at(curved, mode, k, tau, C, S, hs, om, n, u, f0, u1, f1, pp, mem, gr,
+                            us, m, pm, TW)
+        b1, b2, b3 = herm_coeffs(ga, da, gb, db, L)
+        e = abs(gm - (ga + 0.5 * b1 + 0.25 * b2 + 0.125 * b3))
+        M4 = 4.0 * 384.0 * e / ((L * L) * (L * L)) if L > 0.0 else 0.0
+        if not _herm_clear(ga, da, gb, db, L, M4):
+            if depth < CURVED_DEPTH:
+                stack[top, 0] = b
+                stack[top, 1] = gb
+                stack[top, 2] = db
+                stack[top, 4] = depth + 1
+                top += 1
+                b = m
+                gb = gm
+                db = dm
+                depth += 1
+                continue
+            if gm < 0.0:
+                lo = a
+                hi = m
+                ghi = gm
+                break
+        if top == 0:
+            return 2.0, 2.0
+        top -= 1
+        a = b
+        ga = gb
+        da = db
+        b = stack[top, 0]
+        gb = stack[top, 1]
+        db = stack[top, 2]
+        depth = int(stack[top, 4])
+    if lo >= s_best:
+        return 2.0, 2.0
+    glo = _curved_at(curved, mode, k, tau, C, S, hs, om, n, u, f0, u1, f1, pp, mem, gr, us,
+                     lo, pm, TW)[0] if lo > 0.0 else g0
+    side = 0
+    for _ in range(200):
+        if hi - lo <= S_TOL:
+            break
+        sm = illinois_point(lo, hi, glo, ghi)
+        gm = _curved_at(curved, mode, k, tau, C, S, hs, om, n, u, f0, u1, f1, pp, mem, gr, us,
+                        sm, pm, TW)[0]
+        lo, hi, glo, ghi, side = illinois_update(lo, hi, glo, ghi, side, sm, gm)
+    if hi - lo > S_TOL:
+        return -1.0, -1.0
+    return lo, hi
+
+
+@nb.njit(cache=True)
+def _n_curved(G, ng, n):
+    """How many of the ng guard rows are curved."""
+    c = 0
+    for k in range(ng):
+        if math.isnan(G[k, n]):
+            c += 1
+    return c
+
+
+@nb.njit(cache=True, inline="always")
+def _rotate(C, S, th):
+    """(cos, sin) of the forcing phase advanced by th."""
+    cw = math.cos(th)
+    sw = math.sin(th)
+    return C * cw - S * sw, S * cw + C * sw
+
+
+@nb.njit(cache=True)
+def _retake(field, pm, mode, tau, C, S, hs, om, n, u, f0, pp, mem, rtol, atol, us, k1, k2, k3,
+            k4, k5, u1, f1, TW):
+    """The step retaken from (tau, u) to tau + hs, on the RKF45 or on the piece's series
+    (``pm``): u1 and f1 at its end; returns (err2, cos, sin) there."""
+    err2 = 0.0
+    if pm:
+        poly_state(TW, n, hs, u1)
+        C1, S1 = _rotate(C, S, om * hs)
+    else:
+        err2, C1, S1 = _rk_step(field, mode, tau, C, S, hs, om, n, u, f0, pp, mem, rtol, atol,
+                                us, k1, k2, k3, k4, k5, u1)
+    field(mode, tau + hs, C1, S1, u1, pp, mem, f1)
+    return err2, C1, S1
 
 
 @nb.njit(cache=True, inline="always")
@@ -713,7 +923,7 @@ def _qr_logs(Y, out, row):
 @nb.njit(cache=True, fastmath=_FM)
 def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out, M_out,
              Xmax_out, Xmin_out, Y, L_out, cmi, qr, U_out, H, SEC, U_sec, T_sec):
-    field, jacobian, guards, transition, initial, linear = fns
+    field, jacobian, guards, transition, initial, linear, curved = fns
     tan = Y.shape[1] > 0
     # a section surface h = H . (u, 1, cos, sin) = 0 (``advance_tangent``): an extra guard row
     # whose crossings are recorded, never a transition (its sign flips at each crossing)
@@ -730,9 +940,12 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
     mt = Y.shape[1]
     nme = max(nmem, 1)
     nj = n + nmem if tan else 0
-    sizes = (len(p), 10 * n, nme, MAX_GUARDS * (n + 3), MAX_MODES * (N_MC + 7), 4,
+    nlin = max(4, n * n + 3 * n)  # a ``linear`` row: (k, c, b, F), or (A, b, f_c, f_s)
+    m3 = n + 3
+    sizes = (len(p), 10 * n, nme, MAX_GUARDS * (n + 3), MAX_MODES * (N_MC + 7), nlin,
              N_BD * (1 + MAX_GUARDS), (SCAN_DEPTH + 1) * 5, _NS * nt * mt, 6 * nt + nt * nj,
-             2 * nme if tan else 0, len(cmi), mt)
+             2 * nme if tan else 0, len(cmi), mt, n + 1,
+             MAX_MODES * (m3 * m3 + 1) + (N_TAYLOR + 1) * (m3 + 1) + 2 * n)
     total = 0
     for z in sizes:
         total += z
@@ -756,8 +969,8 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
     o += MAX_MODES * 5
     mcs = view(ws, o, (MAX_MODES,))  # class of each mode (_MC_*), 0 = not known yet
     o += MAX_MODES
-    lin = view(ws, o, (4,))
-    o += 4
+    lin = view(ws, o, (nlin,))
+    o += nlin
     BD = view(ws, o, (N_BD,))
     o += N_BD
     GB = view(ws, o, (MAX_GUARDS, N_BD))  # bound coefficients of the guards of a closed form
@@ -777,7 +990,20 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
     ma = view(ws, o, (len(cmi),))
     o += len(cmi)
     tw_last = view(ws, o, (mt,))
-    if o + mt != total:  # the views above and ``sizes`` must agree (views are not bounds-
+    o += mt
+    gr = view(ws, o, (n + 1,))  # gradient of a curved guard
+    o += n + 1
+    MX = view(ws, o, (MAX_MODES, m3 * m3))  # augmented matrix of each _MC_POLY mode
+    o += MAX_MODES * m3 * m3
+    MXR = view(ws, o, (MAX_MODES,))  # its rate rho (a full piece is THETA_POLY / rho)
+    o += MAX_MODES
+    TW = view(ws, o, (N_TAYLOR + 1, m3))  # the Taylor terms of the current piece
+    o += (N_TAYLOR + 1) * m3
+    cp = view(ws, o, (N_TAYLOR + 1,))  # a guard as a polynomial on the piece
+    o += N_TAYLOR + 1
+    rows = view(ws, o, (2, n))
+    pt0, pt1 = rows[0], rows[1]
+    if o + 2 * n != total:  # the views above and ``sizes`` must agree (views are not bounds-
         return st.NON_FINITE  # checked); a mismatch is a bug of this function, caught by tests
     pp[:] = p
     Y = unowned(Y)  # owned by the caller for the whole call
@@ -788,7 +1014,7 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
         return st.NON_FINITE
     rtol = opts[OPT_RTOL]
     atol = opts[OPT_ATOL]
-    closed = opts[OPT_CLOSED_FORM] == 1.0 and n == 2
+    closed = opts[OPT_CLOSED_FORM] == 1.0
     om4 = (om * om) * (om * om)
     for q in range(len(cmi)):
         if cmi[q] < 0 or cmi[q] >= nmem:
@@ -829,6 +1055,7 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
         keep_alive(ws)
         return st.EVENT_FAILED
     ng = min(max(guards(mode, pp, mem, G), 0), MAX_GUARDS)
+    ncv = _n_curved(G, ng, n)
     sgn = 1.0  # orientation of the section row: g = sgn h >= 0 on the side the state is on
     ksec = -1
     n_sec = 0
@@ -842,12 +1069,13 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
         sgn = _section_side(G, ng, H, n, u, f0, C0, S0, om)
         ksec = ng
         ng += 1
-    cls = _mode_class(linear, closed, mode, pp, lin, MC, mcs, om, MF)
+    cls = _mode_class(linear, closed, mode, pp, lin, MC, mcs, om, MF, n, MX, MXR)
     if cls == _MC_RESONANT:
         _store(state, u, n, mem, nmem, mode, h)
         keep_alive(ws)
         return st.RESONANCE
-    cf = cls == _MC_CLOSED
+    cf = cls == _MC_CLOSED and ncv == 0
+    pm = cls == _MC_POLY
     if cf:
         _cf_bounds(MC, mode, om, G, ng, n, GB)
 
@@ -868,7 +1096,11 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
         mask = 1 << mode
         while tau < t_end:
             # ---- immediate exit at the step start: g <= 0 and moving out ----
-            k_tr = _immediate_exit(G, ng, n, u, f0, C, S, om)
+            if ncv == 0:
+                k_tr = _immediate_exit(G, ng, n, u, f0, C, S, om)
+            else:
+                k_tr = _immediate_exit_curved(curved, mode, tau, G, ng, n, u, f0, C, S, om, pp,
+                                              mem, gr)
             if k_tr < 0:
                 if steps >= max_steps:
                     code = st.MAX_STEPS
@@ -900,6 +1132,21 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
                     u1[1] = V1
                     f1[0] = V1
                     f1[1] = A1
+                elif pm:  # a linear mode of any dimension: the series of exp(M s)
+                    Lm = THETA_POLY / MXR[mode]
+                    last = Lm >= rem
+                    hs = rem if last else Lm
+                    taylor_terms(MX[mode], n, u, C, S, TW)
+                    poly_state(TW, n, hs, u1)
+                    C1, S1 = _rotate(C, S, om * hs)
+                    ok = True
+                    for i in range(n):
+                        if not math.isfinite(u1[i]):
+                            ok = False
+                    if not ok:
+                        code = st.NON_FINITE
+                        break
+                    field(mode, tau + hs, C1, S1, u1, pp, mem, f1)
                 else:
                     last = h >= rem * 0.999
                     hs = rem if last else h
@@ -918,6 +1165,26 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
                 s_best = 2.0
                 En = -1.0  # energy norm of a closed-form piece, when needed
                 for k in range(ng):
+                    if pm and not (ncv > 0 and math.isnan(G[k, n])):
+                        guard_poly(G, k, n, TW, cp)
+                        lo, hi = poly_exit(cp, hs, s_best * hs, stack, S_TOL * hs)
+                        if hi < 0.0:
+                            code = st.EVENT_FAILED
+                            break
+                        if hi < s_best * hs:
+                            s_best = hi / hs
+                            k_tr = k
+                        continue
+                    if ncv > 0 and math.isnan(G[k, n]):
+                        lo, hi = _curved_exit(curved, mode, k, tau, C, S, hs, om, n, u, f0, u1,
+                                              f1, pp, mem, gr, us, stack, s_best, pm, TW)
+                        if hi < 0.0:
+                            code = st.EVENT_FAILED
+                            break
+                        if hi < s_best:
+                            s_best = hi
+                            k_tr = k
+                        continue
                     g0 = _gval(G, k, n, u, C, S)
                     d0 = _dgval(G, k, n, f0, C, S, om)
                     if g0 < 0.0:
@@ -1021,26 +1288,45 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
                         if cf:
                             C1, S1 = _cf_state(MC, mode, om, y0, z0, C, S, hs, u1, f1)
                         else:
-                            err2, C1, S1 = _rk_step(field, mode, tau, C, S, hs, om, n, u, f0,
-                                                    pp, mem, rtol, atol, us, k1, k2, k3, k4, k5,
-                                                    u1)
-                            field(mode, tau + hs, C1, S1, u1, pp, mem, f1)
+                            err2, C1, S1 = _retake(field, pm, mode, tau, C, S, hs, om, n, u, f0,
+                                                   pp, mem, rtol, atol, us, k1, k2, k3, k4, k5,
+                                                   u1, f1, TW)
+                            if ncv > 0 and math.isnan(G[k_tr, n]):
+                                # a curved guard: Newton on the true g of the retaken step's
+                                # end (the interpolant is a cubic, the step 5th order)
+                                hs_full = hs / s_best
+                                for _ in range(4):
+                                    gn, dn = _curved_rate(curved, mode, k_tr, tau + hs, C1, S1,
+                                                          n, u1, f1, pp, mem, gr)
+                                    if not dn < 0.0:
+                                        break
+                                    dh = -gn / dn
+                                    if not (abs(dh) > 1e-15 * hs and 0.0 < hs + dh < hs_full):
+                                        break
+                                    hs += dh
+                                    err2, C1, S1 = _retake(field, pm, mode, tau, C, S, hs, om, n,
+                                                           u, f0, pp, mem, rtol, atol, us, k1,
+                                                           k2, k3, k4, k5, u1, f1, TW)
                         if not math.isfinite(u1[0]):
                             code = st.NON_FINITE
                             break
-                elif not cf:
+                elif not cf and not pm:
                     # step-size control after an accepted step without a switch
                     h = _control(err2, hs, h, last, rejected)
                     rejected = False
                 if tan:
                     if cf:
                         _cf_tangent(MC, mode, om, hs, Y, PT)
+                    elif pm:
+                        poly_tangent(MX[mode], n, hs, Y, pt0, pt1)
                     else:
                         _rk_tangent(jacobian, mode, tau, C, S, hs, om, n, u, f0, k1, k2, k3, k4,
                                     k5, pp, mem, Y, W, KY, J, us, cmi)
                 if cf:
                     xmax, xmin = _x_extrema_exact(MC, mode, om, y0, z0, C, S, u[0], u[1], u1[0],
                                                   u1[1], hs, xmax, xmin)
+                elif pm:
+                    xmax, xmin = poly_x_extrema(TW, hs, xmax, xmin)
                 else:
                     xmax, xmin = _x_extrema(u[0], f0[0], u1[0], f1[0], hs, xmax, xmin)
                 for i in range(n):
@@ -1079,7 +1365,13 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
                         gk[i] = G[k_tr, i]
                     for i in range(len(mem)):
                         me[i] = mem[i]
-                    gdot = _dgval(G, k_tr, n, f0, C, S, om)
+                    if math.isnan(G[k_tr, n]):
+                        gdot = _curved_rate(curved, mode, k_tr, tau, C, S, n, u, f0, pp, mem,
+                                            gr)[1]
+                        for i in range(n):
+                            gk[i] = gr[i]
+                    else:
+                        gdot = _dgval(G, k_tr, n, f0, C, S, om)
                 new_mode = transition(mode, k_tr, tau, C, S, u, pp, mem)
                 if tau - t_switch < zeno_dt:
                     n_tiny += 1
@@ -1095,17 +1387,19 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
                 mode = new_mode
                 mask |= 1 << mode
                 ng = min(max(guards(mode, pp, mem, G), 0), MAX_GUARDS)
+                ncv = _n_curved(G, ng, n)
                 if has_sec:
                     if ng >= MAX_GUARDS:
                         code = st.EVENT_FAILED
                         break
                     ksec = ng
                     ng += 1
-                cls = _mode_class(linear, closed, mode, pp, lin, MC, mcs, om, MF)
+                cls = _mode_class(linear, closed, mode, pp, lin, MC, mcs, om, MF, n, MX, MXR)
                 if cls == _MC_RESONANT:
                     code = st.RESONANCE
                     break
-                cf = cls == _MC_CLOSED
+                cf = cls == _MC_CLOSED and ncv == 0
+                pm = cls == _MC_POLY
                 _deriv(cf, field, mode, tau, C, S, u, pp, mem, f0, MC, om)
                 if has_sec:  # the side after the reset: a jump across the surface is no
                     sgn = _section_side(G, ksec, H, n, u, f0, C, S, om)  # crossing

@@ -37,3 +37,8 @@ def call_initial(fns, c, s, u, p, mem):
 @nb.njit(cache=True)
 def call_linear(fns, mode, p, out):
     return fns[5](mode, p, out)
+
+
+@nb.njit(cache=True)
+def call_curved(fns, mode, k, t, c, s, u, p, mem, grad):
+    return fns[6](mode, k, t, c, s, u, p, mem, grad)

@@ -38,9 +38,21 @@ signatures of :mod:`nonsmooth.integrate.contract`). It declares
       is negligible); the kernel reports ``status.ZENO`` for a model that does not.
   ``initial(c, s, u, p, mem) -> mode``
       the mode of a state at t = 0 (and its memory).
-  ``linear(mode, p, out) -> 0 or 1`` (optional, n = 2)
-      1 if the mode is X'' + c X' + k X = F cos(omega t) + b with k > 0 (out[0:4] = k, c, b,
-      F): the exact method then propagates it in closed form.
+  ``curved(mode, k, t, c, s, u, p, mem, grad) -> g`` (optional)
+      guards of any smooth form: a row that ``guards`` marks curved (``curved_row(G, k)``,
+      from ``nonsmooth.models``) is g_k = curved(mode, k, ...), with its gradient written to
+      grad[0:n] (d g / d u) and grad[n] (d g / d t at fixed u); a rotor rubbing a circular
+      stator has g = (delta^2 - x^2 - y^2) / (2 delta) >= 0 in free flight. Curved guards
+      are located on the step's interpolant like affine ones, grazing dips included (the
+      true g is evaluated at the interpolant's critical points), and their gradient enters
+      the saltation matrix; a mode with a curved guard is integrated by RKF45 (no closed form).
+  ``linear(mode, p, out) -> 0, 1 or 2`` (optional)
+      1 (n = 2) if the mode is X'' + c X' + k X = F cos(omega t) + b with k > 0 (out[0:4] =
+      k, c, b, F); 2 (any n, any stiffness) if it is u' = A u + b + f_c cos(omega t) +
+      f_s sin(omega t) with constant coefficients (out[0:n*n] = A row-major, then b, f_c,
+      f_s, n each; ``out`` has max(4, n^2 + 3n) slots): with ``closed_form=True`` the method then propagates it in closed form
+      (the oscillator's formulas, or the series of the augmented matrix exponential,
+      :mod:`nonsmooth.integrate.linmodes`).
 
 * what analyses and plots need: ``contact(params, mask, max_X, min_X)`` (does an orbit with
   this visited-mode mask and these extremes of X count as "in contact", named
@@ -203,8 +215,8 @@ class ModelParams(ParamsBase):
 class Method:
     """How one method (``"smooth"`` or ``"exact"``) of a model is integrated.
 
-    ``field``, ``jacobian``, ``guards``, ``transition``, ``initial``, ``linear``: plain Python
-    functions that numba can compile with the signatures of ``integrate.contract`` (see the
+    ``field``, ``jacobian``, ``guards``, ``transition``, ``initial``, ``linear``, ``curved``:
+    plain Python functions that numba can compile with the signatures of ``integrate.contract`` (see the
     module docstring). ``closed_form``: propagate the modes ``linear`` declares in closed
     form. ``modes``: the mode codes this method uses. ``rtol``/``atol``: tolerances it
     enforces at most (the exact method of a model with nonlinear modes integrates those at a
@@ -235,10 +247,15 @@ class Method:
     variant: int = 0
     admissible: Callable | None = None
     admissible_text: str = ""
+    curved: Callable | None = None
 
 
 def _no_linear(mode, p, out):
     return 0
+
+
+def _no_curved(mode, k, t, c, s, u, p, mem, grad):
+    return math.nan
 
 
 @dataclass(frozen=True, eq=False)
@@ -430,12 +447,12 @@ def compile_method(model: Model, method: str) -> tuple:
 
     from ..integrate.contract import MAX_GUARDS, MODEL_SIGNATURES, CompiledFunction, ModelFns
     m = model.method(method)
-    parts = ("field", "jacobian", "guards", "transition", "initial", "linear")
+    parts = ("field", "jacobian", "guards", "transition", "initial", "linear", "curved")
     fns = []
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", nb.NumbaExperimentalFeatureWarning)
         for part, sig in zip(parts, MODEL_SIGNATURES):
-            fn = getattr(m, part) or _no_linear
+            fn = getattr(m, part) or (_no_curved if part == "curved" else _no_linear)
             try:
                 fns.append(nb.cfunc(sig, cache=True)(fn))
             except Exception as exc:
@@ -458,7 +475,8 @@ def _numba_reason(exc) -> str:
 
 
 def _sample_check(model, method, m, fns, max_guards):
-    from ._probe import call_field, call_guards, call_jacobian, call_transition
+    from ._probe import (call_curved, call_field, call_guards, call_jacobian, call_linear,
+                         call_transition)
     n = model.n
     bad = lambda msg: ParameterError(f"model {model.name}: {method}.{msg}")  # noqa: E731
     try:
@@ -501,14 +519,78 @@ def _sample_check(model, method, m, fns, max_guards):
             j = cols[j]
             raise bad(f"jacobian disagrees with the field in mode {name}: J[{i},{j}] = "
                       f"{J[i, j]:.6g}, finite differences give {fd[i, j]:.6g}")
+        if m.closed_form and m.linear is not None:
+            _check_linear(model, fns, mode, p, u, mem, t, c, s, du, bad, call_linear)
         ng = int(call_guards(fns, mode, p, mem, G))
         if not 0 <= ng <= max_guards:
             raise bad(f"guards returns {ng} surfaces in mode {name} (allowed 0..{max_guards})")
         for k in range(ng):
+            if math.isnan(G[k, n]):
+                _check_curved(model, m, fns, mode, k, p, u, mem, bad, call_curved)
             new = int(call_transition(fns, mode, k, t, c, s, u.copy(), p, mem.copy()))
             if not 0 <= new < len(model.mode_names):
                 raise bad(f"transition from mode {name} through surface {k} goes to unknown "
                           f"mode {new} (modes: 0..{len(model.mode_names) - 1})")
+
+
+def _check_linear(model, fns, mode, p, u, mem, t, c, s, du, bad, call_linear):
+    """A mode that ``linear`` declares (1: the oscillator, 2: the general form) has the field
+    it declares, at the sample point (``du`` holds the field there)."""
+    n = model.n
+    out = np.zeros(max(4, n * n + 3 * n))
+    r = int(call_linear(fns, mode, p, out))
+    if r == 1 and n == 2:
+        want = np.array([u[1], -out[0] * u[0] - out[1] * u[1] + out[3] * c + out[2]])
+    elif r == 2:
+        A = out[:n * n].reshape(n, n)
+        b, fc, fs = out[n * n:n * n + n], out[n * n + n:n * n + 2 * n], out[n * n + 2 * n:]
+        want = A @ u + b + fc * c + fs * s
+    else:
+        return
+    if not np.allclose(du, want, rtol=1e-9, atol=1e-9 * max(1.0, float(np.abs(du).max()))):
+        i = int(np.argmax(np.abs(du - want)))
+        raise bad(f"linear: mode {model.mode_names[mode]} is not the linear mode it declares: "
+                  f"d{model.state_names[i]}/dt = {du[i]:.6g} by the field, {want[i]:.6g} by "
+                  f"linear (kind {r}) at the sample point u = 0.5")
+
+
+def _check_curved(model, m, fns, mode, k, p, u, mem, bad, call_curved):
+    """A curved guard (``curved_row``) at the sample point: ``curved`` given, finite, and its
+    gradient (state and time) equal to finite differences."""
+    name = model.mode_names[mode]
+    if m.curved is None:
+        raise bad(f"guards marks surface {k} of mode {name} curved, but the method has no "
+                  "curved function")
+    n = model.n
+    om = float(p[model.index[model.omega]])
+
+    def g_at(t, uu):
+        grad = np.zeros(n + 1)
+        return float(call_curved(fns, mode, k, t, math.cos(om * t), math.sin(om * t), uu, p,
+                                 mem, grad)), grad
+
+    t = 0.1
+    g, grad = g_at(t, u)
+    if not (math.isfinite(g) and np.all(np.isfinite(grad))):
+        raise bad(f"curved: surface {k} of mode {name} is not finite at the sample point "
+                  "u = 0.5")
+    fd = np.zeros(n + 1)
+    for j in range(n + 1):
+        h = 1e-6
+        if j < n:
+            up, um = u.copy(), u.copy()
+            up[j] += h
+            um[j] -= h
+            fd[j] = (g_at(t, up)[0] - g_at(t, um)[0]) / (2 * h)
+        else:
+            fd[j] = (g_at(t + h, u)[0] - g_at(t - h, u)[0]) / (2 * h)
+    scale = max(1.0, float(np.max(np.abs(fd))))
+    err = np.abs(grad - fd)
+    if not np.all(err <= 1e-5 * scale):
+        j = int(np.argmax(err))
+        what = f"d g / d u[{j}]" if j < n else "d g / d t"
+        raise bad(f"curved: the gradient of surface {k} in mode {name} disagrees with the "
+                  f"surface: {what} = {grad[j]:.6g}, finite differences give {fd[j]:.6g}")
 
 
 # ---- registry --------------------------------------------------------------------------------

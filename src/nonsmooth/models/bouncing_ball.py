@@ -9,8 +9,9 @@ restitution r; the dimensionless acceleration is Gamma = A omega^2 / g.
 An impact slower than V_STICK (g / omega) while the table presses the ball (its acceleration
 above -g) ends a chattering sequence: the ball rides on the table (mode ``stuck``, Z = V = 0)
 until the table's downward acceleration exceeds g, when it takes off again, so complete
-chattering ends in finite time, never Zeno. Free flight has no closed form of the linear
-oscillator (no stiffness): RKF45 at rtol 1e-12.
+chattering ends in finite time, never Zeno. Free flight (no stiffness) and riding on the
+table are linear modes propagated in closed form (the series of the augmented matrix
+exponential, ``integrate.linmodes``).
 
 ``method="smooth"``: the table is a stiff linear spring-damper, mode ``contact`` while Z < 0,
 force -k_c Z - c V with c = 2 zeta sqrt(k_c) and zeta = -ln r / sqrt(pi^2 + ln^2 r), so that
@@ -60,8 +61,8 @@ MODEL = model_from_equations(
                     "stuck": [Guard("g - A*omega**2*sin(omega*t)", "flight")]},
             initial=[(f"Z <= 0 and V <= 0 and {PRESSING}", "stuck")],
             admissible="Z >= 0",
-            description="Newton's impact law, chatter ending in sticking; RKF45 at rtol 1e-12 "
-                        "in flight"),
+            description="Newton's impact law, chatter ending in sticking; flight in closed "
+                        "form"),
         "smooth": dict(
             modes={"flight": ["V", FLIGHT],
                    "contact": ["V", f"{FLIGHT} - k_c*Z - 2*{ZETA}*sqrt(k_c)*V"]},

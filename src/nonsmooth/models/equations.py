@@ -5,14 +5,19 @@ written as expressions (strings or SymPy), into an ordinary :class:`~nonsmooth.m
 It derives what the model interface (:mod:`nonsmooth.models.base`) asks for by hand:
 
 * the Jacobian of every mode's field (SymPy differentiation, common subexpressions shared);
-* the guards as affine rows: a surface must be affine in the state and in cos(omega t),
-  sin(omega t) (coefficients may depend on the parameters); its coefficients are read off
-  exactly. A surface that is not affine, or that depends on neither the state nor the
-  forcing phase, is refused with one line naming it (one of the phase alone is a timed exit,
-  e.g. a stuck mass released when the forcing turns);
-* the closed form of linear modes (two states X, V with X' = V and
-  V' = -k X - c V + F cos(omega t) + b, k > 0, coefficients of the parameters only): the
-  ``exact`` method then propagates them exactly, as the built-in models do;
+* the guards: a surface affine in the state and in cos(omega t), sin(omega t) (coefficients
+  may depend on the parameters) becomes an affine row, its coefficients read off exactly;
+  any other smooth surface (a circle sqrt(X^2 + Y^2) = delta, a surface with t) becomes a
+  *curved* guard, evaluated with its derived gradient (state and time) by the generated
+  ``curved`` function. A surface that depends on neither the state nor the time is refused
+  with one line naming it (one of the phase alone is a timed exit, e.g. a stuck mass
+  released when the forcing turns);
+* the closed form of linear modes: u' = A u + b + f_c cos(omega t) + f_s sin(omega t) with
+  coefficients of the parameters only, any dimension and any stiffness (free flight, gravity,
+  several coupled masses, a mass resting on a stop), propagated by the series of the
+  augmented matrix exponential (``integrate.linmodes``), and the oscillator's own closed form
+  (two states X, V with X' = V, V' = -k X - c V + F cos(omega t) + b, k > 0) where it applies:
+  the ``exact`` method then propagates them exactly, as the built-in models do;
 * ``transition`` (the first branch whose condition holds; resets evaluated with the values
   before the event) and ``initial`` (the first of the given (condition, mode) pairs that
   holds, else the first mode whose surfaces are all >= 0, else the first mode).
@@ -65,7 +70,8 @@ _RESERVED = {"t", "pi", *FUNCTIONS, *SMOOTH_STEPS}  # (the generated code rename
 @dataclass(frozen=True)
 class Guard:
     """A switching surface of one mode: ``surface`` is >= 0 inside the mode and the mode is
-    left when it turns negative (affine in the state and in cos/sin(omega t)).
+    left when it turns negative (any smooth expression of the state, the parameters and t;
+    affine ones are the kernel's fast case).
 
     ``to``: the mode entered (a name), or branches ``[(condition, mode), ...]`` or
     ``[(condition, mode, reset), ...]`` tried in order at the event: the first whose condition
@@ -84,7 +90,7 @@ def model_from_equations(name: str, *, states, parameters, modes: dict | None = 
                          forcing_amplitude: str | None = None, description: str = "",
                          flow_is_homeomorphism: bool = False, closed_form: bool = True,
                          rtol: float | None = None, atol: float | None = None,
-                         contact_modes=(), **model_kw) -> Model:
+                         admissible=None, contact_modes=(), **model_kw) -> Model:
     """A :class:`Model` from equations (see the module documentation).
 
     ``states``: names, e.g. ``("X", "V")``. ``parameters``: ``{name: default}``,
@@ -93,7 +99,9 @@ def model_from_equations(name: str, *, states, parameters, modes: dict | None = 
     ...]}`` (one expression per state, in order). ``guards``: ``{mode name: [Guard, ...]}`` (a
     tuple ``(surface, to)`` or ``(surface, to, reset)`` is read as a Guard). ``rtol``/``atol``:
     the tolerances the method enforces at most (default for an "exact" method with a mode
-    that has no closed form: :data:`EXACT_RTOL`, :data:`EXACT_ATOL`). ``initial``:
+    that has no closed form: :data:`EXACT_RTOL`, :data:`EXACT_ATOL`). ``admissible``: a
+    condition on the state and the parameters that a start must satisfy (e.g.
+    ``"X <= delta"``). ``initial``:
     ``[(condition, mode), ...]`` classifying a state at t = 0 (default: the first mode whose
     surfaces hold). ``method``: the name of the method these equations define ("exact"
     for a non-smooth system, "smooth" for a regularised one). Several methods:
@@ -114,11 +122,18 @@ def model_from_equations(name: str, *, states, parameters, modes: dict | None = 
     if methods is None:
         methods = {method: dict(modes=modes, guards=guards, initial=initial, rtol=rtol,
                                 atol=atol, description=description,
-                                flow_is_homeomorphism=flow_is_homeomorphism)}
+                                flow_is_homeomorphism=flow_is_homeomorphism,
+                                admissible=admissible)}
     elif modes is not None or guards is not None or initial is not None or method != "exact" \
-            or rtol is not None or atol is not None or flow_is_homeomorphism:
-        raise bad("with methods={...}, give modes, guards, initial, rtol, atol and "
-                  "flow_is_homeomorphism per method, not as arguments")
+            or rtol is not None or atol is not None or flow_is_homeomorphism \
+            or admissible is not None:
+        raise bad("with methods={...}, give modes, guards, initial, rtol, atol, admissible "
+                  "and flow_is_homeomorphism per method, not as arguments")
+    from dataclasses import fields as _fields
+    allowed = {f.name for f in _fields(Model)}
+    for k in model_kw:
+        if k not in allowed:
+            raise bad(f"unknown keyword {k!r}")
     states = tuple(states)
     params = _parameters(parameters, bad)
     pnames = tuple(q.name for q in params)
@@ -177,12 +192,16 @@ def _method(sp, ctx, name, mname, spec, states, pnames, mode_names, closed_form,
         for j, g in enumerate(glist):
             g = g if isinstance(g, Guard) else Guard(*g)
             where = f"mode {mode}, surface {j}"
-            rows[mode].append(ctx.affine_row(ctx.parse(g.surface, where), where))
+            rows[mode].append(ctx.surface(ctx.parse(g.surface, where), where))
             branches[mode].append(ctx.branches(g, where, own, mode_names))
     init = [(ctx.condition(cond, f"initial, condition {i}"), mode_names.index(m))
             for i, (cond, m) in enumerate(spec.get("initial") or ())
             if _mode_index(m, own, bad) >= 0]
-    linear = {m: ctx.linear(fields[m]) for m in own} if closed_form and n == 2 else {}
+    # the closed form of linear modes: the oscillator's (n = 2, k > 0) where it applies, else
+    # the general form (any n, any stiffness: ``integrate.linmodes``)
+    linear = {m: (ctx.linear(fields[m]) if n == 2 else None, ctx.linear_general(fields[m]))
+              for m in own} if closed_form else {}
+    linear = {m: v for m, v in linear.items() if v[1] is not None}
     try:
         source = _source(sp, ctx, states, pnames, mode_names, own, fields, rows, branches,
                          init, linear)
@@ -191,13 +210,15 @@ def _method(sp, ctx, name, mname, spec, states, pnames, mode_names, closed_form,
                   f"({type(exc).__name__}: {str(exc).splitlines()[0] if str(exc) else ''})"
                   ) from None
     module = _load(f"{name}_{mname}", source)
-    has_linear = any(v is not None for v in linear.values())
+    has_linear = bool(linear)
     rtol, atol = spec.get("rtol"), spec.get("atol")
     if mname == "exact" and rtol is None and atol is None \
-            and not all(linear.get(m) is not None for m in own):
+            and not all(m in linear for m in own):
         rtol, atol = EXACT_RTOL, EXACT_ATOL  # nonlinear modes of an exact method: RKF45, tight
+    curved = any(not isinstance(r, list) for rs in rows.values() for r in rs)
     return Method(module.field, module.jacobian, module.guards, module.transition,
                   module.initial, module.linear if has_linear else None,
+                  curved=module.curved if curved else None,
                   closed_form=has_linear,
                   flow_is_homeomorphism=bool(spec.get("flow_is_homeomorphism", False)),
                   modes=tuple(mode_names.index(m) for m in own), rtol=rtol, atol=atol,
@@ -358,23 +379,26 @@ class _Context:
             return self.parse(ast.unparse(node), where)
         return walk(tree)
 
-    def affine_row(self, g, where):
-        """Coefficients (d/du_i ..., constant, cos, sin) of an affine surface."""
+    def surface(self, g, where):
+        """An affine surface's row: coefficients [d/du_i ..., constant, cos, sin]; any other
+        surface as its expression (a curved guard)."""
         sp = self.sp
         var = self.states + [self.C, self.S]
+        if not (g.free_symbols & (set(var) | {self.t})) or all(
+                sp.simplify(sp.diff(g, v)) == 0 for v in var + [self.t]):
+            raise self.bad(f"{where}: the surface {g} has a zero gradient (it depends on "
+                           f"neither the state nor the time)")
+        if g.has(sp.Piecewise, sp.sign, sp.floor, sp.Abs, sp.Min, sp.Max):
+            raise self.bad(f"{where}: the surface {g} is not smooth (Piecewise, sign, floor, "
+                           f"Abs, Min or Max): write one surface per smooth piece")
         if self.t in g.free_symbols:
-            raise self.bad(f"{where}: a surface may depend on time only through cos(omega t) "
-                           f"and sin(omega t)")
+            return g
         coef = [sp.diff(g, v) for v in var]
         const = g.subs({v: 0 for v in var})
         rest = sp.simplify(g - sum((c * v for c, v in zip(coef, var)), const))
         if any(c.free_symbols & set(var) for c in coef) or rest.free_symbols & set(var) \
                 or rest != 0:
-            raise self.bad(f"{where}: the surface {g} is not affine in the state and "
-                           f"cos/sin(omega t) (curved surfaces are not supported yet)")
-        if all(sp.simplify(c) == 0 for c in coef):  # (a surface of time alone is allowed)
-            raise self.bad(f"{where}: the surface {g} has a zero gradient (it depends on "
-                           f"neither the state nor cos/sin(omega t))")
+            return g  # curved
         n = len(self.states)
         return coef[:n] + [const, coef[n], coef[n + 1]]
 
@@ -404,6 +428,29 @@ class _Context:
             out.append((cond, mode_names.index(mode), rs))
         return out
 
+    def linear_general(self, f):
+        """(A, b, f_c, f_s) where the mode is u' = A u + b + f_c cos(omega t) + f_s sin(omega t)
+        with coefficients of the parameters only, else None."""
+        sp = self.sp
+        var = self.states + [self.C, self.S]
+        n = len(self.states)
+        A, b, fc, fs = [], [], [], []
+        for fi in f:
+            fi = sp.expand(fi)
+            coef = [sp.diff(fi, v) for v in var]
+            if any(c.free_symbols & (set(var) | {self.t}) for c in coef):
+                return None
+            const = fi.subs({v: 0 for v in var})
+            if const.free_symbols & {self.t}:
+                return None
+            if sp.simplify(fi - (sum((c * v for c, v in zip(coef, var)), const))) != 0:
+                return None  # a step term (Piecewise, sign) has zero derivatives
+            A.append(coef[:n])
+            b.append(const)
+            fc.append(coef[n])
+            fs.append(coef[n + 1])
+        return A, b, fc, fs
+
     def linear(self, f):
         """(k, c, b, F) where the mode is X' = V, V' = -k X - c V + F cos + b with constant
         coefficients (k > 0 is checked at run time), else None."""
@@ -430,7 +477,7 @@ class _Context:
 
 def _source(sp, ctx, states, pnames, mode_names, own, fields, rows, branches, init,
             linear) -> str:
-    """The Python source of the six model functions."""
+    """The Python source of the seven model functions."""
     from sympy.printing.pycode import PythonCodePrinter
 
     n = len(states)
@@ -471,7 +518,8 @@ def _source(sp, ctx, states, pnames, mode_names, own, fields, rows, branches, in
     iw = pnames.index(ctx.omega.name)
     exprs = [e for f in fields.values() for e in f] + [c for c, _ in init] + [
         e for brs in branches.values() for br in brs for c, _, rs in br
-        for e in (c, *rs.values())]
+        for e in (c, *rs.values())] + [
+        r for rs in rows.values() for r in rs if not isinstance(r, list)]
     uses_t = any(ctx.t in sp.sympify(e).free_symbols for e in exprs)
     wrap_t = [f"    _T = 2.0 * math.pi / p[{iw}]", "    if t >= _T:", "        t -= _T"] \
         if uses_t else []
@@ -510,11 +558,34 @@ def _source(sp, ctx, states, pnames, mode_names, own, fields, rows, branches, in
         out = []
         for k, row in enumerate(rows.get(m, ())):
             cols = list(range(n)) + [n, n + 1, n + 2]
-            out += [f"G[{k}, {col}] = float({code(v)})" for col, v in zip(cols, row)]
+            if isinstance(row, list):
+                out += [f"G[{k}, {col}] = float({code(v)})" for col, v in zip(cols, row)]
+            else:  # curved (``models.oscillator.curved_row``)
+                out += [f"G[{k}, {col}] = 0.0" for col in cols if col != n]
+                out += [f"G[{k}, {n}] = math.nan"]
         return out + [f"return {len(rows.get(m, ()))}"] if out else []
 
     src += ["", "", "def guards(mode, p, mem, G):", *unpack_p]
     src += by_mode(guard_body)
+
+    def curved_body(m):
+        # g, its gradient in the state and its partial time derivative at fixed u (cos and
+        # sin(omega t) turn with t: d/dt = d/dt + omega (-s d/dc + c d/ds))
+        out = []
+        w = ctx.omega
+        for k, row in enumerate(rows.get(m, ())):
+            if isinstance(row, list):
+                continue
+            dt = sp.diff(row, ctx.t) + w * (-ctx.S * sp.diff(row, ctx.C)
+                                            + ctx.C * sp.diff(row, ctx.S))
+            exprs = [row] + [sp.diff(row, x) for x in X] + [dt]
+            lines = cse_lines(exprs, ["_g"] + [f"grad[{i}]" for i in range(n + 1)])
+            out += [f"if k == {k}:"] + [f"    {ln}" for ln in lines] + ["    return _g"]
+        return out + ["return math.nan"] if out else []
+
+    src += ["", "", "def curved(mode, k, t, c, s, u, p, mem, grad):", *wrap_t, *unpack_u,
+            *unpack_p]
+    src += by_mode(curved_body, default="return math.nan")
 
     def transition_body(m):
         out = []
@@ -539,17 +610,21 @@ def _source(sp, ctx, states, pnames, mode_names, own, fields, rows, branches, in
         tests = []
         for row in rows.get(mname, ()):
             g = sum((row[i] * X[i] for i in range(n)), sp.Integer(0)) + row[n] \
-                + row[n + 1] * ctx.C + row[n + 2] * ctx.S
+                + row[n + 1] * ctx.C + row[n + 2] * ctx.S if isinstance(row, list) else row
             tests.append(f"({code(g)}) >= 0.0")
         src.append(f"    if {' and '.join(tests) or 'True'}:\n        return {m}")
     src += [f"    return {mode_names.index(own[0])}"]
 
     def linear_body(m):
-        lin = linear.get(m)
-        if lin is None:
+        if m not in linear:
             return []
-        return [f"out[{i}] = float({code(v)})" for i, v in enumerate(lin)] + \
-            ["return 1 if out[0] > 0.0 else 0"]
+        osc, (A, b, fc, fs) = linear[m]
+        out = []
+        if osc is not None:  # the oscillator's closed form where k > 0
+            out += [f"out[{i}] = float({code(v)})" for i, v in enumerate(osc)]
+            out += ["if out[0] > 0.0:", "    return 1"]
+        flat = [a for row in A for a in row] + list(b) + list(fc) + list(fs)
+        return out + [f"out[{i}] = float({code(v)})" for i, v in enumerate(flat)] + ["return 2"]
 
     src += ["", "", "def linear(mode, p, out):", *unpack_p]
     src += by_mode(linear_body)

@@ -14,8 +14,9 @@ with mu = m2/m1, omega1^2 = k1/m1, xi1 = c1/m1, omega2^2 = k2/m2, xi2 = c2/m2.
 ``method="exact"``: Newton's impact law at X = delta, V -> -r V (Y and W do not jump). An
 impact slower than V_STICK while the forces press the mass onto the stop ends a chattering
 sequence: the mass rests on the stop (mode ``stuck``: X = delta, V = 0, the secondary mass
-still moving) until the force on it pulls it away. The modes are linear with four states:
-RKF45 at rtol 1e-12 (closed forms exist for n = 2 only).
+still moving) until the force on it pulls it away. Both modes are linear with four states:
+propagated in closed form (the series of the augmented matrix exponential,
+``integrate.linmodes``).
 
 ``method="smooth"``: the stop is a stiff spring-damper, mode ``contact`` while X > delta,
 force -k_c (X - delta) - c V with c = 2 zeta sqrt(k_c), zeta = -ln r / sqrt(pi^2 + ln^2 r), so
@@ -74,8 +75,8 @@ MODEL = model_from_equations(
                     "stuck": [Guard(PRESS, "free")]},
             initial=[(f"X >= delta and V >= 0 and {PRESS} >= 0", "stuck")],
             admissible="X <= delta",
-            description="Newton's impact law at the stop, chatter ending in sticking; RKF45 "
-                        "at rtol 1e-12 between impacts"),
+            description="Newton's impact law at the stop, chatter ending in sticking; closed "
+                        "form between impacts"),
         "smooth": dict(
             modes={"free": ["V", PRIMARY, "W", SECONDARY],
                    "contact": ["V", f"{PRIMARY} - k_c*(X - delta) - 2*{ZETA}*sqrt(k_c)*V",

@@ -1,6 +1,8 @@
 """Helpers shared by the built-in one-degree-of-freedom models (state u = (X, V)): a switching
 surface as an affine guard row (see :mod:`.base`), inlined into the models' compiled
-functions."""
+functions; :func:`curved_row` marks a guard of any smooth form, for models of any dimension."""
+
+import math
 
 import numba as nb
 
@@ -19,3 +21,13 @@ def forced_row(G, k, cx, cv, c0, ccos):
 def row(G, k, cx, cv, c0):
     """Surface k: g = cx X + cv V + c0 (>= 0 inside the mode)."""
     forced_row(G, k, cx, cv, c0, 0.0)
+
+
+@nb.njit(cache=True, inline="always")
+def curved_row(G, k):
+    """Surface k is curved: the kernel evaluates it, and its gradient, by the method's
+    ``curved(mode, k, t, c, s, u, p, mem, grad)`` (marker: NaN in the constant column)."""
+    n = G.shape[1] - 3
+    for i in range(G.shape[1]):
+        G[k, i] = 0.0
+    G[k, n] = math.nan
