@@ -246,3 +246,113 @@ def test_a_reset_that_jumps_across_the_section_is_no_crossing():
     assert np.all(sec.X.values < 1.0 - 1e-6)
     assert np.all(np.abs(sec.V.values) < 1e-9)
     assert np.all(np.diff(sec.X.values) < 0)  # decaying swings
+
+
+def _wall_cycle(zeta, r):
+    """The self-excited impact oscillator X'' - 2 zeta X' + X = 0 (negative damping) with a
+    wall at X = 1 (V -> -r V): its limit cycle leaves the wall with V = -r v and returns to it
+    with V = v after the time tau, X(t) = e^{zeta t} (cos nu t + B sin nu t). Solved from the
+    closed form (bisection on v, the first return found on a fine grid and refined): (tau, the
+    smallest X of the cycle, where V = 0)."""
+    nu = math.sqrt(1.0 - zeta * zeta)
+
+    def X(t, v):
+        B = (-r * v - zeta) / nu
+        return math.exp(zeta * t) * (math.cos(nu * t) + B * math.sin(nu * t))
+
+    def Xd(t, v):
+        B = (-r * v - zeta) / nu
+        e = math.exp(zeta * t)
+        return e * ((zeta + nu * B) * math.cos(nu * t) + (zeta * B - nu) * math.sin(nu * t))
+
+    def ret(v):
+        ts = np.linspace(1e-6, 4 * math.pi / nu, 40001)
+        g = np.array([X(t, v) - 1.0 for t in ts])
+        i = int(np.flatnonzero((g[:-1] < 0) & (g[1:] >= 0))[0])
+        a, b = ts[i], ts[i + 1]
+        for _ in range(200):
+            m = 0.5 * (a + b)
+            a, b = (m, b) if X(m, v) < 1.0 else (a, m)
+        return 0.5 * (a + b)
+
+    lo, hi = 0.05, 20.0
+    f = lambda v: Xd(ret(v), v) - v  # noqa: E731
+    assert f(lo) > 0 > f(hi)
+    for _ in range(100):
+        m = 0.5 * (lo + hi)
+        lo, hi = (m, hi) if f(m) > 0 else (lo, m)
+    v = 0.5 * (lo + hi)
+    tau = ret(v)
+    a, b = 1e-9, tau  # X' goes from -r v < 0 to v > 0: its zero is the cycle's smallest X
+    for _ in range(200):
+        m = 0.5 * (a + b)
+        a, b = (m, b) if Xd(m, v) < 0.0 else (a, m)
+    return tau, X(0.5 * (a + b), v)
+
+
+def test_a_model_without_forcing_its_limit_cycle_against_the_closed_form_and_refusals(
+        tmp_path, capsys):
+    """A model that declares no forcing (omega=None), written as equations: a self-excited
+    impact oscillator (negative damping, a wall with restitution r). Its limit cycle's period
+    and its section point (V = 0, the smallest X) equal the closed form; the stroboscopic analyses refuse it in one
+    line (exit 2 on the CLI)."""
+    zeta, r = 0.05, 0.8
+    m = ns.model_from_equations(
+        "self_excited_wall", states=("X", "V"), parameters={"zeta": zeta, "r": r},
+        modes={"free": ["V", "2*zeta*V - X"]},
+        guards={"free": [ns.Guard("1 - X", "free", reset={"V": "-r*V"})]}, omega=None)
+    assert m.autonomous and m.params().period == pytest.approx(2 * math.pi)
+    tau, x_min = _wall_cycle(zeta, r)
+    lc = ns.limit_cycle(m.params(), ("V", "increasing"), x0=0.5, transient=30)
+    assert lc.attrs["status"] == "converged"
+    assert float(lc.period) == pytest.approx(tau, abs=1e-9)
+    assert float(lc.max_X) == pytest.approx(1.0, abs=1e-9)
+    assert float(lc.X_section) == pytest.approx(x_min, abs=1e-9)  # on V = 0, increasing
+    assert float(lc.multiplier_abs[0]) < 1.0  # a stable cycle
+    for call, who in ((lambda p: ns.poincare(p, transient=10), "poincare"),
+                      (lambda p: ns.periodic_orbit(p), "periodic_orbit"),
+                      (lambda p: ns.bifurcation_diagram(p, "zeta", [0.05, 0.06]),
+                       "bifurcation_diagram"),
+                      (lambda p: ns.basins(p, grid=4), "basins")):
+        with pytest.raises(ParameterError, match=f"^{who}: model self_excited_wall declares "
+                                                 f"no forcing"):
+            call(m.params())
+    with pytest.raises(ParameterError, match="cannot use the time t"):
+        ns.model_from_equations("bad", states=("X", "V"), parameters={"a": 1.0},
+                                modes={"free": ["V", "-X + cos(t)"]}, omega=None)
+    from cli_helpers import one_line, run_cli
+    f = tmp_path / "wall.py"
+    f.write_text("import nonsmooth as ns\n"
+                 "MODEL = ns.model_from_equations('self_excited_wall', states=('X', 'V'),\n"
+                 "    parameters={'zeta': 0.05, 'r': 0.8}, modes={'free': ['V', '2*zeta*V - X']},\n"
+                 "    guards={'free': [ns.Guard('1 - X', 'free', reset={'V': '-r*V'})]},\n"
+                 "    omega=None)\n")
+    for cmd in ("poincare", "bifurcation", "orbit", "basins"):
+        code, _, err = run_cli([cmd, "--model", f"{f}:MODEL", "--plot",
+                                str(tmp_path / "x.png")], capsys)
+        assert code == 2
+        one_line(err, "declares no forcing (omega=None)")
+    code, out, _ = run_cli(["limit-cycle", "--model", f"{f}:MODEL", "--section", "V",
+                            "--direction", "increasing", "--x0", "0.5", "-o",
+                            str(tmp_path / "lc.nc")], capsys)
+    assert code == 0 and "period" in out
+
+
+def test_surface_bifurcation_diagram_follows_the_stick_slip_cycle(tmp_path, capsys):
+    """Along the belt speed, the crossings of V = 0 (decreasing) after a transient are those of
+    the Coulomb stick-slip cycle (its closed form, as ``limit_cycle_branch``): one crossing per
+    turn at the cycle's section point, the cycle's period; the CLI writes the diagram."""
+    p = M.params()
+    vb = np.linspace(0.1, 0.4, 4)
+    ds = ns.surface_bifurcation_diagram(p, "v_belt", vb, crossings=6, transient=20, v0=1.0)
+    ref = np.array([coulomb_cycle(p.replace(v_belt=v)) for v in vb])
+    assert np.all(ds.status.values == 0) and np.all(ds.cycle_crossings.values == 1)
+    assert np.max(np.abs(ds.X.values - ref[:, 1:2])) < 1e-9
+    assert np.allclose(ds.cycle_period.values, ref[:, 0], atol=1e-9)
+    from cli_helpers import run_cli
+    fig = tmp_path / "sb.png"
+    code, out, _ = run_cli(["surface-bifurcation", "--param", "v_belt", "--from", "0.1",
+                            "--to", "0.4", "--steps", "4", "--v0", "1", "--crossings", "6",
+                            "--transient", "20", "--plot", str(fig)], capsys)
+    assert code == 0 and "4 cycles (1 crossing(s) per turn: 4)" in out
+    assert fig.stat().st_size > 0

@@ -1,6 +1,6 @@
 """The built-in ``bouncing_ball`` (written as equations) against its closed forms: the
 period-one orbit, its Floquet multipliers, its period doubling and its fold (located by
-continuation with the section moved off the impact), the smooth method converging to the exact
+continuation, which moves the section off the impact), the smooth method converging to the exact
 one, chatter ending in sticking."""
 
 import math
@@ -43,19 +43,23 @@ def test_period_one_orbit_its_multipliers_and_its_period_doubling():
         assert (np.min(mu.real) < -1.0) == crossed
 
 
-def test_continuation_locates_the_fold_only_with_the_section_off_the_impact():
-    """At the fold the impact falls on t = kT: at phase 0 continuation cannot pass it; with
-    the section at phase pi it locates it."""
-    found = {}
+def test_continuation_passes_the_fold_where_the_impact_falls_on_the_section():
+    """At the fold the impact falls on t = kT: at phase 0 the period map is not smooth there
+    and the corrector fails, so continuation moves the section a quarter period on (carrying
+    the branch point and its tangent with the flow) and goes on; with the section at phase pi
+    from the start it never needs to. Both locate the fold at Gamma = pi (1 - r)/(1 + r)."""
     for psi in (0.0, math.pi):
         p, z0, v0 = on_orbit(1.3, psi)
         br = ns.continuation(p, "A", x0=z0, v0=v0, direction="down",
                              bounds=(0.5 * G1 / W**2, 1.45 / W**2), section_phase=psi)
-        found[psi] = (br.attrs["status"], br.special_type.values, br["special_A"].values * W**2)
-    assert "cannot continue" in found[0.0][0] and found[0.0][1].size == 0
-    status, types, gammas = found[math.pi]
-    assert list(types) == [1] and "bounds" in status  # one fold, then out of the bounds
-    assert gammas[0] == pytest.approx(G1, abs=1e-9)
+        assert list(br.special_type.values) == [1] and "bounds" in br.attrs["status"]
+        assert br["special_A"].values[0] * W**2 == pytest.approx(G1, abs=1e-9)
+        if psi == 0.0:
+            assert "to 1.5708 rad" in br.attrs["section_moved"]
+            ph = br.section_phase.values
+            assert ph[0] == 0.0 and ph[-1] == pytest.approx(math.pi / 2)
+        else:
+            assert "section_moved" not in br.attrs
 
 
 def test_smooth_table_converges_to_the_impact_law():

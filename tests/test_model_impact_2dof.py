@@ -163,9 +163,13 @@ def test_cli_starts_from_u0_shows_the_named_components_and_refuses_unknown_ones(
     assert code == 0 and fig.stat().st_size > 0
     with xr.open_dataset(out) as ds:
         assert ns.io.components(ds).values[0].tolist() == [0.1, 0.0, 0.3, 0.0]
-    code, stdout, _ = run_cli(["orbit", "-m", "impact_2dof", "--transient", "300"], capsys)
-    assert code == 0 and "Y(jT)" in stdout and "W(jT)" in stdout
+    orb = tmp_path / "o.png"
+    code, stdout, _ = run_cli(["orbit", "-m", "impact_2dof", "--transient", "300", "--show",
+                               "Y,W", "--plot", str(orb)], capsys)
+    assert code == 0 and "Y(jT)" in stdout and "W(jT)" in stdout and orb.stat().st_size > 0
     for argv, needle in ((["simulate", "-m", "impact_2dof", "--show", "X,Q"],
+                          "show: unknown component 'Q'"),
+                         (["orbit", "-m", "impact_2dof", "--show", "X,Q"],
                           "show: unknown component 'Q'"),
                          (["poincare", "-m", "impact_2dof", "--show", "X"],
                           "show: expected two state components"),

@@ -38,6 +38,7 @@ _LAZY = {
     "two_parameter_curve": ".analysis.continuation",
     "parameter_map": ".analysis.parameter_map",
     "surface_section": ".analysis.autonomous",
+    "surface_bifurcation_diagram": ".analysis.autonomous",
     "limit_cycle": ".analysis.autonomous",
     "equilibria": ".analysis.autonomous",
     "equilibrium_branch": ".analysis.autonomous",
@@ -52,7 +53,7 @@ _SUBMODULES = ("analysis", "cli", "errors", "integrate", "io", "kernels", "model
 
 __all__ = ["__version__", "Params", "PARAM_NAMES", "model", "models", "model_from_equations", "Guard", "preset", "PRESETS", "simulate", "reproduce", "Solver",
            "eta_study", "lyapunov", "periodic_orbit", "continuation", "two_parameter_curve", "parameter_map", "poincare", "bifurcation_diagram", "resonance_curve", "basins",
-           "surface_section", "limit_cycle", "equilibria", "equilibrium_branch",
+           "surface_section", "surface_bifurcation_diagram", "limit_cycle", "equilibria", "equilibrium_branch",
            "limit_cycle_branch", "surface_basins",
            "NonsmoothError", "ParameterError", "OutputError", "IntegrationError"]
 

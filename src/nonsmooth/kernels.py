@@ -187,7 +187,7 @@ class Solver:
         o[OPT_ATOL] = self.atol if m.atol is None else min(self.atol, m.atol)
         o[OPT_MAX_STEPS] = self.max_steps
         o[OPT_VARIANT] = m.variant
-        o[OPT_OMEGA] = self.model.index[self.model.omega]
+        o[OPT_OMEGA] = self.model.frame_index
         o[OPT_N] = self.model.n
         o[OPT_NMEM] = self.model.n_memory
         o[OPT_CLOSED_FORM] = 1.0 if m.closed_form else 0.0

@@ -47,6 +47,16 @@ def check_params(params) -> ParamsBase:
     return params
 
 
+def check_forced(params, who: str) -> None:
+    """A one-line ParameterError where ``who`` (a stroboscopic analysis) gets a model that
+    declares no forcing: it has no period to sample."""
+    if check_params(params).model.autonomous:
+        raise ParameterError(f"{who}: model {params.model.name} declares no forcing "
+                             f"(omega=None): a stroboscopic map has no period to sample; use "
+                             f"its section surfaces (limit_cycle, limit_cycle_branch, "
+                             f"surface_basins, equilibria) or simulate")
+
+
 def initial_u(model, x0=0.0, v0=0.0, u0=None) -> np.ndarray:
     """The initial state u (all ``model.n`` components) from ``x0``, ``v0`` (u[0], u[1]; the
     other components 0) or from ``u0``: a sequence of n numbers in the order of
@@ -244,7 +254,8 @@ def simulate(params: ParamsBase, *, periods: int, transient: int = 0,
     Xmin = np.concatenate([[state[0]], rec["Xmin"][0]])
     U = np.concatenate([state_u(params.model, state)[None, :], rec["U"][0]])
     T = params.period
-    t0 = transient * T + solver.section_phase / getattr(params, params.model.omega)
+    w = params.model.omega
+    t0 = transient * T + solver.section_phase / (getattr(params, w) if w else 1.0)
     t = t0 + np.arange(n + 1) * (T / spp)
     modes = params.model.mode_names
     regions = flag_attrs(modes, dtype=np.int8)

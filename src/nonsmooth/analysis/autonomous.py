@@ -243,16 +243,7 @@ def surface_section(params, section="V", *, crossings: int = 200, transient: int
     if status != "ok":
         raise IntegrationError(f"surface_section: {status}")
     ret = np.diff(np.concatenate([[0.0], Tc]))
-    q_found, period = 0, math.nan
-    scale = 1.0 + float(np.max(np.abs(U)))
-    # crossings that converge onto an equilibrium (a focus: the field vanishes there) repeat
-    # too, but are no cycle
-    at_rest = float(np.linalg.norm(flow.field(s))) <= 1e-6 * scale
-    for q in range(1, 0 if at_rest else min(16, crossings // 2) + 1):
-        if np.max(np.abs(U[q:] - U[:-q])) <= 1e-6 * scale:
-            q_found, period = q, float(np.mean([Tc[i + q] - Tc[i]
-                                                for i in range(crossings - q)]))
-            break
+    q_found, period, at_rest = _repetition(flow, s, U, Tc)
     return xr.Dataset(
         {
             **_xv(params.model, "crossing", U, " at the crossing"),
@@ -273,6 +264,120 @@ def surface_section(params, section="V", *, crossings: int = 200, transient: int
         attrs=provenance_attrs(params, solver, analysis="surface_section", section=text,
                                transient=transient, **start_attrs(u_start),
                                max_time=flow.max_time),
+    )
+
+
+def _repetition(flow, s, U, Tc):
+    """(q, cycle period, at rest) of recorded crossings U at times Tc, the state ``s`` after
+    the last: the smallest q <= 16 with U repeating after q crossings to 1e-6 (1 + |U|) (0:
+    none; NaN period), and whether they converge onto an equilibrium (the field vanishes at
+    ``s`` to 1e-6: a focus, whose crossings repeat too but are no cycle)."""
+    crossings = len(U)
+    q_found, period = 0, math.nan
+    scale = 1.0 + float(np.max(np.abs(U)))
+    at_rest = float(np.linalg.norm(flow.field(s))) <= 1e-6 * scale
+    for q in range(1, 0 if at_rest else min(16, crossings // 2) + 1):
+        if np.max(np.abs(U[q:] - U[:-q])) <= 1e-6 * scale:
+            q_found, period = q, float(np.mean([Tc[i + q] - Tc[i]
+                                                for i in range(crossings - q)]))
+            break
+    return q_found, period, at_rest
+
+
+def _param_values(params, param, values):
+    """(parameter name, values as a 1-D float array) of a sweep; one-line errors."""
+    if not isinstance(param, str):
+        raise ParameterError(f"param: expected a parameter name, got {param!r}")
+    param = params.model.param(param).name
+    try:
+        values = np.asarray(values, dtype=float).ravel()
+    except (TypeError, ValueError):
+        raise ParameterError(f"values: expected numbers, got {values!r}") from None
+    if values.size < 1 or not np.all(np.isfinite(values)):
+        raise ParameterError(f"values: expected finite values of {param}")
+    for v in (values.min(), values.max()):
+        params.replace(**{param: float(v)})  # in the parameter's range
+    return param, values
+
+
+def surface_bifurcation_diagram(params, param: str, values, section="V", *,
+                                crossings: int = 50, transient: int = 100, x0: float = 0.0,
+                                v0: float = 0.0, u0=None, method: str = "exact",
+                                rtol: float = 1e-10, atol: float = 1e-12,
+                                max_time: float = 1e4) -> xr.Dataset:
+    """The bifurcation diagram of a self-excited system on a section surface: for each value of
+    ``param`` in the order given (each run goes on from the previous value's last state, so
+    the sweep follows an attractor, as ``bifurcation_diagram`` does for forced systems),
+    ``transient`` crossings of ``section`` (see the module docstring) are skipped and the next
+    ``crossings`` recorded.
+
+    Returns a Dataset over (``param``, ``crossing``): the state at the crossings (``X``, ``V``
+    and one variable per further component) and the ``return_time`` from the crossing before;
+    over ``param``: ``cycle_crossings`` (the smallest q <= 16 after which the crossings repeat
+    to 1e-6; 0: none, e.g. chaos or a torus), ``cycle_period``, ``at_equilibrium`` (the
+    crossings converge onto an equilibrium) and ``status`` (0 ok; 1 the orbit failed or
+    stopped crossing within ``max_time``: NaN crossings, and the sweep goes on from the start
+    state). A failing value never stops the sweep."""
+    from ..simulate import check_int, check_params, start_attrs
+    params = check_params(params)
+    param, values = _param_values(params, param, values)
+    crossings = check_int("crossings", crossings, 2)
+    transient = check_int("transient", transient, 0)
+    params0, solver, _, text = _setup(params.replace(**{param: float(values[0])}), section,
+                                      method, rtol, atol, max_time,
+                                      "surface_bifurcation_diagram")
+    u_start, s0 = _start(params0, solver, x0, v0, u0)
+    n = params.model.n
+    U = np.full((values.size, crossings, n), np.nan)
+    RT = np.full((values.size, crossings), np.nan)
+    q = np.zeros(values.size, np.int64)
+    per = np.full(values.size, np.nan)
+    rest = np.zeros(values.size, np.int8)
+    status = np.zeros(values.size, np.int8)
+    notes = []
+    s = s0.copy()
+    for i, v in enumerate(values):
+        p_i, _, flow, _ = _setup(params.replace(**{param: float(v)}), section, method, rtol,
+                                 atol, max_time, "surface_bifurcation_diagram")
+        why = "ok"
+        if transient:
+            why = flow.crossings(s, transient)[0]
+        if why == "ok":
+            why, _, Ui, Tc, _ = flow.crossings(s, crossings, record=crossings)
+        if why != "ok":
+            status[i] = 1
+            notes.append(f"{param} = {v:g}: {why}")
+            s = s0.copy()
+            continue
+        U[i] = Ui
+        RT[i] = np.diff(np.concatenate([[0.0], Tc]))
+        q[i], per[i], at_rest = _repetition(flow, s, Ui, Tc)
+        rest[i] = int(at_rest)
+    spec = params.model.param(param)
+    return xr.Dataset(
+        {
+            **_xv(params.model, (param, "crossing"), U, " at the crossing"),
+            "return_time": ((param, "crossing"), RT, {
+                "long_name": "time from the crossing before", "units": "s"}),
+            "cycle_crossings": (param, q, {"long_name": "crossings per cycle (0: no "
+                                                        "repetition found)", "units": "1"}),
+            "cycle_period": (param, per, {"long_name": "period of the cycle", "units": "s"}),
+            "at_equilibrium": (param, rest, {
+                "long_name": "1: the crossings converge onto an equilibrium",
+                "flag_values": np.array([0, 1], np.int8),
+                "flag_meanings": "moving at_equilibrium"}),
+            "status": (param, status, {
+                "long_name": "0: recorded; 1: the orbit failed or stopped crossing the "
+                             "section (see the attr notes)",
+                "flag_values": np.array([0, 1], np.int8), "flag_meanings": "ok failed"}),
+        },
+        coords={param: (param, values, {"long_name": spec.long_name, "units": spec.units}),
+                "crossing": np.arange(crossings)},
+        attrs=provenance_attrs(params, solver, swept=(param,),
+                               analysis="surface_bifurcation_diagram", param=param,
+                               section=text, transient=transient, crossings=crossings,
+                               notes="; ".join(notes) or "none", **start_attrs(u_start),
+                               max_time=float(max_time)),
     )
 
 
@@ -420,7 +525,7 @@ def _sample_cycle(params, solver, state, period, samples):
         R[i] = int(s[ST_MODE])
         # one output interval of length dt: a "period" T' = dt (omega' = 2 pi / dt)
         pp = p.copy()
-        pp[params.model.index[params.model.omega]] = 2.0 * math.pi / dt
+        pp[params.model.frame_index] = 2.0 * math.pi / dt
         bufs = output_buffers(1)
         code = run(KERNEL_GENERIC, solver.fns, pp, opts, s, 1, 0, 1, *bufs)
         if code != st.OK:
@@ -652,15 +757,7 @@ def limit_cycle_branch(params, param: str, values, section="V", *, x0: float = 0
     from ..io import components
     from ..simulate import check_params
     params = check_params(params)
-    if not isinstance(param, str):
-        raise ParameterError(f"param: expected a parameter name, got {param!r}")
-    param = params.model.param(param).name
-    try:
-        values = np.asarray(values, dtype=float).ravel()
-    except (TypeError, ValueError):
-        raise ParameterError(f"values: expected numbers, got {values!r}") from None
-    if values.size < 1 or not np.all(np.isfinite(values)):
-        raise ParameterError(f"values: expected finite values of {param}")
+    param, values = _param_values(params, param, values)
     n = params.model.n
     m = n - 1
     Z = np.full((values.size, n), np.nan)

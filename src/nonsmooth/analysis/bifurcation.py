@@ -526,6 +526,8 @@ def bifurcation_diagram(params: ParamsBase, param: str, values, *, sweep: str = 
     ``progress`` (None or False: silent; True: a progress bar with a time estimate on a terminal,
     plain lines elsewhere; or a callable ``progress(done, total)``): reports the work done.
     """
+    from ..simulate import check_forced
+    check_forced(params, "bifurcation_diagram")
     from ..sweep import progress_callback
     progress = progress_callback(progress, "bifurcation")
     from ..chunks import check_engine

@@ -188,6 +188,10 @@ def continuation(params, param: str, *, start=None, k: int = 1, x0: float = 0.0,
     at first, "down") with arclength steps starting at ``step`` (in the units of the
     parameter and the section point, adapted between step x MIN_STEP and ``max_step``, default
     10 x step) until it leaves ``bounds`` (lo, hi), reaches ``max_points`` or cannot continue.
+    Where the corrector fails at every step, the section may sit on an event of the orbit (an
+    impact at t = kT makes the map non-smooth): the section is then moved a quarter, a half or
+    three quarters of a period on (``_moved_section``) and the branch goes on there; the
+    points then have a ``section_phase`` variable and the attrs a ``section_moved`` text.
 
     Returns a Dataset over ``point``: the parameter, the section points (``X_section``,
     ``V_section`` over ``point``, ``j``; a model with more state components has
@@ -196,6 +200,8 @@ def continuation(params, param: str, *, start=None, k: int = 1, x0: float = 0.0,
     over ``special`` (``special_type`` with CF flags, ``special_<param>``, the multiplier
     nearest the crossing and the point index after which it lies); attrs ``status`` (why the
     branch ended)."""
+    from ..simulate import check_forced
+    check_forced(params, "continuation")
     params, solver, p0, opts, state = start_trajectory(params, x0, v0, method, rtol, atol,
                                                        section_phase, u0)
     u_start = state_u(params.model, state)
@@ -259,8 +265,12 @@ def continuation(params, param: str, *, start=None, k: int = 1, x0: float = 0.0,
     t = br.tangent(ev, t)
     if t[N] * (1.0 if direction == "up" else -1.0) < 0:
         t = -t
-    pts = [(y, br.features(y, ev, t))]
+    phase = solver.section_phase
+    f_start = br.features(y, ev, t)
+    f_start["phase"] = phase
+    pts = [(y, f_start)]
     specials = []
+    moves = []  # (point index, new section phase): where the section was moved off an event
     ds = step
     status = "max_points"
     while len(pts) < max_points:
@@ -272,24 +282,86 @@ def continuation(params, param: str, *, start=None, k: int = 1, x0: float = 0.0,
                 break
             ds *= 0.5
         if got is None:
-            status = f"cannot continue (the corrector fails even at step x {MIN_STEP:g})"
-            break
+            # an event on the section (e.g. an impact at t = kT) makes the map non-smooth
+            # there: move the section by a quarter period and go on from the same orbit
+            moved = _moved_section(br, solver, y0, t, step)
+            if moved is None:
+                status = f"cannot continue (the corrector fails even at step x {MIN_STEP:g})"
+                break
+            solver, setup, br, y0, t, got, ds = moved
+            phase = solver.section_phase
+            moves.append((len(pts) - 1, phase))
         y1, ev1, iters = got
         t1 = br.tangent(ev1, t)
         f1 = br.features(y1, ev1, t1)
+        f1["phase"] = phase
         for typ in (FOLD, PERIOD_DOUBLING, NEIMARK_SACKER, GRAZING):
             a, b = f0["tests"][typ], f1["tests"][typ]
             if math.isfinite(a) and math.isfinite(b) and a * b < 0:
                 sp = _locate(br, typ, y0, t, ds, a, b)
                 if sp is not None and _confirmed(typ, sp[1]):
-                    specials.append((typ, len(pts) - 1, *sp))
+                    specials.append((typ, len(pts) - 1, *sp, phase))
         pts.append((y1, f1))
         t = t1
         if not lo <= y1[N] <= hi:
             status = "left the bounds"
             break
         ds = min(max_step, ds * 1.5) if iters <= 3 else (ds * 0.5 if iters > 6 else ds)
-    return _dataset(params, solver, param, k, pts, specials, status, N, direction, bounds)
+    ds = _dataset(params, solver, param, k, pts, specials, status, N, direction, bounds)
+    if moves:
+        ds["section_phase"] = ("point", np.array([f["phase"] for _, f in pts]), {
+            "long_name": "forcing phase omega t_s of the section of each point (moved off "
+                         "events that fell on the section)", "units": "rad"})
+        ds.attrs["section_moved"] = "; ".join(f"after point {i}: to {ph:.6g} rad"
+                                              for i, ph in moves)
+        ds["special_section_phase"] = ("special", np.array([sp[-1] for sp in specials], float),
+                                       {"long_name": "forcing phase of the section where the "
+                                                     "special point was located", "units": "rad"})
+        ds.attrs["section_phase"] = float(section_phase)
+    return ds
+
+
+def _moved_section(br, solver, y, t, step):
+    """Where the corrector fails at every step, the section may sit on an event of the orbit
+    (an impact at t = kT: the map is not smooth there). Try the section a quarter, a half and
+    three quarters of a period later: the branch point y (section point, parameter) is carried
+    there by the flow, its tangent by central differences of that flow, and a first step of
+    ``step`` (halved as usual) must then succeed. Returns (solver, setup, branch, y, t,
+    corrected point, step) at the new section, or None."""
+    import dataclasses
+    N = br.setup.N
+    for q in (1, 2, 3):
+        new = (solver.section_phase + q * 0.5 * math.pi) % (2.0 * math.pi)
+        s2 = dataclasses.replace(solver, section_phase=new)
+        setup2 = TangentSetup(s2)
+
+        def carry(yy):
+            s = _section_state(br.setup, br.p(yy[N]), yy[:N], br.template)
+            if run(KERNEL_GENERIC, br.setup.fns, br.p(yy[N]), br.setup.opts, s, 4, q, 0,
+                   *output_buffers(0)) != st.OK:
+                return None, None
+            return setup2.z_of(s), s
+
+        z, s_new = carry(y)
+        h = 1e-6 * max(1.0, float(np.linalg.norm(y)))
+        zp, _ = carry(y + h * t)
+        zm, _ = carry(y - h * t)
+        if z is None or zp is None or zm is None:
+            continue
+        t2 = np.r_[(zp - zm) / (2.0 * h), t[N]]
+        t2 /= np.linalg.norm(t2)
+        y2 = np.r_[z, y[N]]
+        br2 = _Branch(setup2, br.p0, br.index, br.k, br.tol, br.level)
+        br2.template = s_new
+        if br2.correct(y2, t2) is None:  # the point itself, at the new section
+            continue
+        ds = step
+        while ds >= step * MIN_STEP:
+            got = br2.correct(y2 + ds * t2, t2)
+            if got is not None:
+                return s2, setup2, br2, y2, t2, got, ds
+            ds *= 0.5
+    return None
 
 
 def _doubled_orbit(params, param, start, method, tol, rtol, atol, section_phase=0.0):
@@ -303,10 +375,13 @@ def _doubled_orbit(params, param, start, method, tol, rtol, atol, section_phase=
     if typ != PERIOD_DOUBLING:
         raise ParameterError(f"start: special point {i} is a {SPECIAL_NAMES.get(typ, typ)}, "
                              f"not a period doubling")
-    if float(src.attrs.get("section_phase", 0.0)) != section_phase:
-        raise ParameterError(f"start: the branch was continued at section_phase = "
-                             f"{float(src.attrs.get('section_phase', 0.0)):g}, not "
-                             f"{section_phase:g}: give the same section_phase")
+    # the phase of the section where the point was located (the branch may have moved it)
+    sp_phase = (float(src["special_section_phase"][i]) if "special_section_phase" in src
+                else float(src.attrs.get("section_phase", 0.0)))
+    if sp_phase != section_phase:
+        raise ParameterError(f"start: the period doubling was located with the section at "
+                             f"phase {sp_phase:.17g}, not {section_phase:g}: give "
+                             f"section_phase={sp_phase:.17g}")
     if src.attrs.get("param") != param:
         raise ParameterError(f"start: the branch was continued in {src.attrs.get('param')}, "
                              f"not in {param}")
@@ -495,6 +570,8 @@ def two_parameter_curve(params, param: str, param2: str, values2, *, special: st
     (in ascending order; NaN where fewer were found), the critical multiplier and
     ``special_jump``; ``status`` per value of ``param2`` (how the branch ended). Each point is
     located to 1e-10 on its branch; the curve is as fine as ``values2``."""
+    from ..simulate import check_forced
+    check_forced(params, "two_parameter_curve")
     names = {v: kk for kk, v in SPECIAL_NAMES.items()}
     if special not in names or names[special] == 0:
         raise ParameterError(f"special: expected one of fold, period_doubling, "

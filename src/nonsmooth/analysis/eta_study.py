@@ -164,6 +164,8 @@ def eta_study(params: ParamsBase, etas, *, transient: int = 300, record: int | N
     ``store`` / ``engine``: chunked, resumable runs (:data:`ETA_CHUNK` etas per chunk, the
     exact model one more) and where they run (see ``nonsmooth.chunks``).
     """
+    from ..simulate import check_forced
+    check_forced(params, "eta_study")
     from ..sweep import progress_callback
     progress = progress_callback(progress, "eta study")
     from ..chunks import Plan, check_engine, chunk_bounds, execute, plan_solver

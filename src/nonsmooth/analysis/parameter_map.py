@@ -132,6 +132,8 @@ def parameter_map(params: ParamsBase, x=("omega", 0.8, 1.0, 100), y=("F0", 0.15,
     ``progress`` (None or False: silent; True: a progress bar with a time estimate on a terminal,
     plain lines elsewhere; or a callable ``progress(done, total)``): reports the work done.
     """
+    from ..simulate import check_forced
+    check_forced(params, "parameter_map")
     from ..sweep import progress_callback
     progress = progress_callback(progress, "map")
     from ..chunks import Plan, check_engine, execute, plan_solver

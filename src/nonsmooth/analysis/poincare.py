@@ -275,6 +275,8 @@ def poincare(params: ParamsBase, *, record: int | None = None, transient: int, x
 
     Raises IntegrationError if the trajectory fails (sweeps record failures instead).
     """
+    from ..simulate import check_forced
+    check_forced(params, "poincare")
     from ..sweep import progress_callback
     progress = progress_callback(progress, "poincare")
     from ..io import check_memory, flag_attrs, status_flags

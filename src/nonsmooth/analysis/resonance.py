@@ -190,6 +190,8 @@ def resonance_curve(params: ParamsBase, omegas, *, method: str = "smooth", trans
     ``progress`` (None or False: silent; True: a progress bar with a time estimate on a terminal,
     plain lines elsewhere; or a callable ``progress(done, total)``): reports the work done.
     """
+    from ..simulate import check_forced
+    check_forced(params, "resonance_curve")
     from ..sweep import progress_callback
     progress = progress_callback(progress, "resonance")
     from ..chunks import check_engine

@@ -236,6 +236,8 @@ def periodic_orbit(params, *, k: int = 1, x0: float = 0.0, v0: float = 0.0,
     sampled ``samples_per_period`` times a period (so with other steps than Newton's), and is
     reported converged only if it closes on itself to ``CONFIRM_TOL`` (1 + |z|).
     Bad input raises one-line ParameterErrors; a failed search is a status, not an error."""
+    from ..simulate import check_forced
+    check_forced(params, "periodic_orbit")
     params, solver, p, opts, state = start_trajectory(params, x0, v0, method, rtol, atol,
                                                       section_phase, u0)
     u_start = state_u(params.model, state)
@@ -475,7 +477,7 @@ def lambda1_points(P, solver, states, periods: int, *, blocks: int = 10, workers
         S[:, ST_MODE] = -1.0
         S[:, ST_H] = 0.0
     n = P.shape[0]
-    om = P[:, solver.model.index[solver.model.omega]]
+    om = P[:, solver.model.frame_index]
     T = 2.0 * np.pi / om
     Ys = np.zeros((n, setup.N))
     Ys[:, :2] = 1.0
@@ -545,7 +547,7 @@ def floquet_lambda1_points(P, solver, states, period, *, workers=None):
     with threads(workers), deferred_interrupts():
         _monodromy_many(setup.fns, P, setup.opts, S, k, setup.N, setup.cmi, mono, status)
     lam = np.full(n, np.nan)
-    om = P[:, solver.model.index[solver.model.omega]]
+    om = P[:, solver.model.frame_index]
     T = 2.0 * np.pi / om
     ok = status == st.OK
     groups = {}

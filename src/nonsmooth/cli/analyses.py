@@ -151,6 +151,8 @@ def bifurcation_cmd(
     params = load_params(preset, set_, model, "table3", method=method)
     method = resolve_method(params, method)
     preset = preset_label(params, preset, "table3")
+    from ..simulate import check_forced
+    check_forced(params, "bifurcation")
     param = params.model.param(param or params.model.omega).name
     if sweep not in SWEEPS:
         raise ParameterError(f"sweep: unknown sweep {sweep!r} (known: {', '.join(SWEEPS)})")
@@ -210,6 +212,8 @@ def resonance_cmd(
     params = load_params(preset, set_, model, "fig6a", method=method)
     method = resolve_method(params, method)
     preset = preset_label(params, preset, "fig6a")
+    from ..simulate import check_forced
+    check_forced(params, "resonance")
     w = params.model.omega  # the model's forcing frequency
     omegas = value_range(from_, to, steps, f"{w} range", 2, max(record, 0))
     for v in (omegas[0], omegas[-1]):

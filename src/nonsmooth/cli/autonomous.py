@@ -1,5 +1,6 @@
-"""`nonsmooth limit-cycle` and `nonsmooth equilibria`: self-excited (unforced) systems, whose
-limit cycles have unknown periods and whose sections are surfaces (issue 23, item 3)."""
+"""`nonsmooth limit-cycle`, `nonsmooth surface-bifurcation` and `nonsmooth equilibria`:
+self-excited (unforced) systems, whose limit cycles have unknown periods and whose sections are
+surfaces (issue 23, item 3)."""
 
 from __future__ import annotations
 
@@ -9,8 +10,8 @@ import typer
 
 from .analyses import V0Opt, X0Opt
 from .app import app
-from .common import (DEFAULT_MODEL, AtolOpt, ModelOpt, OutOpt, PresetOpt, RtolOpt, SetOpt,
-                     U0Opt, check_outputs, echo_written, load_params, preset_label,
+from .common import (DEFAULT_MODEL, AtolOpt, ModelOpt, OutOpt, PlotOpt, PresetOpt, RtolOpt,
+                     SetOpt, U0Opt, check_outputs, echo_written, load_params, preset_label,
                      resolve_method, save_outputs)
 from .stability import EXIT_NOT_FOUND, OrbitMethodOpt, _num, print_table
 
@@ -135,3 +136,63 @@ def equilibria_cmd(
             typer.echo(f"  Hopf at {param} = {h:.10g} (frequency {w:.6g} rad/s)")
     save_outputs(ds, preset, out, None)
     echo_written(out)
+
+
+@app.command("surface-bifurcation")
+def surface_bifurcation_cmd(
+    param: Annotated[str, typer.Option("--param", help="the parameter swept")],
+    from_: Annotated[float, typer.Option("--from", help="first value")],
+    to: Annotated[float, typer.Option("--to", help="last value")],
+    model: ModelOpt = "stick_slip",
+    preset: PresetOpt = None,
+    set_: SetOpt = None,
+    steps: Annotated[int, typer.Option("--steps", help="values of --param (>= 2)")] = 100,
+    section: SectionOpt = "V",
+    direction: DirectionOpt = "decreasing",
+    x0: X0Opt = 0.0,
+    v0: V0Opt = 0.0,
+    u0: U0Opt = None,
+    transient: Annotated[int, typer.Option(
+        "--transient", help="crossings skipped at each value")] = 100,
+    crossings: Annotated[int, typer.Option(
+        "--crossings", help="crossings recorded at each value")] = 50,
+    max_time: Annotated[float, typer.Option(
+        "--max-time", help="time allowed to reach the next crossing")] = 1e4,
+    method: OrbitMethodOpt = None,
+    rtol: RtolOpt = 1e-10,
+    atol: AtolOpt = 1e-12,
+    show: Annotated[Optional[str], typer.Option(
+        "--show", show_default=False, help="the state component plotted (default X)")] = None,
+    out: OutOpt = None,
+    plot: PlotOpt = None,
+):
+    """Bifurcation diagram of a self-excited system on a section surface: at each value of
+    --param (each run continuing from the previous one), the crossings of the section after a
+    transient; cycles, their crossings per turn, and values that come to rest."""
+    from ..analysis.autonomous import surface_bifurcation_diagram
+    from ..plot.autonomous import plot_surface_bifurcation
+    from ..plot.common import check_show
+    from .analyses import value_range
+
+    params = load_params(preset, set_, model, method=method)
+    method = _method(params, method)
+    preset = preset_label(params, preset, None)
+    check_outputs(out, plot)
+    if show is not None:
+        check_show(f"{show},{show}", params.model.state_names)
+    values = value_range(from_, to, steps, f"{param} range")
+    ds = surface_bifurcation_diagram(params, param, values, (section, direction),
+                                     crossings=crossings, transient=transient, x0=x0, v0=v0,
+                                     u0=u0, method=method, rtol=rtol, atol=atol,
+                                     max_time=max_time)
+    save_outputs(ds, preset, out, plot, lambda d: plot_surface_bifurcation(d, show))
+    q = ds.cycle_crossings.values
+    cyc = q > 0
+    n_rest, n_fail = int(ds.at_equilibrium.sum()), int(ds.status.sum())
+    kinds = ", ".join(f"{k} crossing(s) per turn: {int((q == k).sum())}"
+                      for k in sorted(set(q[cyc].tolist())))
+    typer.echo(f"{preset} ({method}): {values.size} values of {param} on "
+               f"{ds.attrs['section']}: {int(cyc.sum())} cycles ({kinds or 'none'}), {n_rest} "
+               f"at rest, {values.size - int(cyc.sum()) - n_rest - n_fail} without repetition, "
+               f"{n_fail} failed")
+    echo_written(out, plot)

@@ -37,8 +37,8 @@ RtolOpt = Annotated[float, typer.Option("--rtol", help="relative tolerance")]
 AtolOpt = Annotated[float, typer.Option("--atol", help="absolute tolerance")]
 SectionPhaseOpt = Annotated[float, typer.Option(
     "--section-phase", help="forcing phase (radians, 0 <= phase < 2 pi) of the stroboscopic "
-                            "section t = t_s + kT: the trajectory starts there (move it off "
-                            "events that fall on t = kT, e.g. to continue through a fold)")]
+                            "section t = t_s + kT: the trajectory starts there (continuation "
+                            "moves it off events that fall on it by itself)")]
 U0Opt = Annotated[Optional[str], typer.Option(
     "--u0", show_default=False,
     help="initial state of any components, NAME=VALUE,... in the model's state names (e.g. "

@@ -129,6 +129,8 @@ def continue_cmd(
                f"{param} = {lam[0]:.6g} to {lam[-1]:.6g} (range {lam.min():.6g} ... "
                f"{lam.max():.6g}), {int(stable.sum())} stable, {int((~stable).sum())} unstable")
     typer.echo(f"status: {ds.attrs['status']}")
+    if "section_moved" in ds.attrs:
+        typer.echo(f"section moved off an event on it: {ds.attrs['section_moved']}")
     n = ds.sizes["special"]
     if n:
         sp = ds[f"special_{param}"].values

@@ -62,6 +62,8 @@ def map_cmd(
     params = load_params(preset, set_, model, "table3", method=method)
     method = resolve_method(params, method)
     preset = preset_label(params, preset, "table3")
+    from ..simulate import check_forced
+    check_forced(params, "map")
     w = params.model.omega
     x = tuple(x) if x is not None else (w, 0.8, 1.0, 100)
     if y is None:

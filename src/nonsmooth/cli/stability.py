@@ -10,7 +10,7 @@ import typer
 
 from .analyses import TransientOpt, V0Opt, X0Opt, _progress
 from .app import app
-from .common import (U0Opt, DEFAULT_MODEL, SectionPhaseOpt, AtolOpt, MethodOpt, ModelOpt, OutOpt, PlotOpt, PresetOpt, RtolOpt, SetOpt,
+from .common import (U0Opt, DEFAULT_MODEL, SectionPhaseOpt, AtolOpt, MethodOpt, ModelOpt, OutOpt, PlotOpt, PresetOpt, RtolOpt, SetOpt, ShowOpt,
                      check_outputs, echo_written, load_params, preset_label, resolve_method,
                      save_outputs)
 
@@ -123,10 +123,11 @@ def orbit_cmd(
     section_phase: SectionPhaseOpt = 0.0,
     out: OutOpt = None,
     plot: PlotOpt = None,
+    show: ShowOpt = None,
 ):
     """A k-periodic orbit, stable or unstable, by Newton shooting from (x0, v0): section
     points, Floquet multipliers, stability, max/min X and contact fraction; a phase portrait
-    with the multipliers. Exit status 1 when no orbit was found."""
+    with the multipliers (in the plane --show names). Exit status 1 when no orbit was found."""
     from ..analysis.stability import periodic_orbit
     from ..simulate import check_int
 
@@ -139,6 +140,8 @@ def orbit_cmd(
     check_int("transient", transient, 0)
     check_int("max_iter", max_iter, 1)
     check_outputs(out, plot)
+    from ..plot.common import check_show
+    pair = check_show(show, params.model.state_names)
     ds = periodic_orbit(params, k=k, x0=x0, v0=v0, u0=u0, method=method, transient=transient,
                         tol=tol, max_iter=max_iter, rtol=rtol, atol=atol,
                       section_phase=section_phase)
@@ -154,7 +157,7 @@ def orbit_cmd(
         raise typer.Exit(EXIT_NOT_FOUND)
     from ..io import components
     from ..plot.stability import multiplier_value, plot_orbit
-    save_outputs(ds, preset, out, plot, plot_orbit)
+    save_outputs(ds, preset, out, plot, lambda d: plot_orbit(d, show=pair))
     typer.echo(f"{preset} ({method}): period-{k} orbit converged in {a['iterations']} "
                f"iterations (residual {a['residual']:.3g})")
     print_table(("point",) + tuple(f"{nm}(jT)" for nm in params.model.state_names),

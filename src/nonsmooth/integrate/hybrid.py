@@ -24,7 +24,8 @@ Design summary
   otherwise the step is halved left to right until each piece's Hermite of (g, g'), less an
   error bound estimated from the true g at its midpoint, clears zero, so grazing dips are
   found; the crossing is located by Illinois on the true g. Its gradient enters the saltation
-  matrix. A mode with a curved guard is never taken in closed form.
+  matrix. A mode with a curved guard is never taken in the oscillator's closed form (the
+  series of ``linmodes`` evaluates curved guards on its exact polynomial).
 * A guard with forcing terms (G[k, n+1], G[k, n+2]) is not a cubic along a step, and a step can
   be long (a stick phase has a zero error estimate, so its RKF45 steps grow to a whole output
   interval): its exit test is certified, and so is every guard on a closed-form piece (the
@@ -383,7 +384,7 @@ def _mode_class(linear, closed, mode, pp, lin, MC, mcs, om, MF, n, MX, MXR):
     if mcs[mode] == _MC_UNKNOWN:
         mcs[mode] = _MC_RK
         r = linear(mode, pp, lin)
-        if r == 1 and n == 2 and lin[0] > 0.0:
+        if r == 1 and n == 2 and lin[0] > 0.0 and lin[1] >= 0.0:  # (the bounds need c >= 0)
             MF[mode] = lin[3]
             if mode_coeffs(lin[0], lin[1], lin[2], lin[3], om, THETA, MC[mode]):
                 mcs[mode] = _MC_CLOSED
@@ -501,41 +502,28 @@ def _immediate_exit_curved(curved, mode, tau, G, ng, n, u, f0, C, S, om, pp, mem
 
 
 @nb.njit(cache=True)
-def _curved_exit(curved, mode, k, tau, C, S, hs, om, n, u, f0, u1, f1, pp, mem, gr, us, stack,
-                 s_best, pm, TW):
-    """Exit test of curved guard k over the step just taken: (lo, hi) bracketing its first
-    crossing to S_TOL of the step (g(lo) >= 0 > g(hi)), (2.0, 2.0) when it stays >= 0 up to
-    ``s_best`` (an earlier crossing of another guard), (-1.0, -1.0) when location fails.
-
-    A step whose ends clear zero by twice the Hermite slope bound is passed at once. Otherwise
-    pieces are taken left to right: a piece passes when the cubic Hermite of (g, g') at its
-    ends, less four times the quartic error bound estimated from the true g at its midpoint,
-    stays >= 0 (``_herm_clear``); else it is halved (at most CURVED_DEPTH times). On a piece
-    whose end is negative, the Hermite's interior minima are evaluated too, so the crossing
-    found is the first one, grazing dips included."""
-    g0, d0 = _curved_rate(curved, mode, k, tau, C, S, n, u, f0, pp, mem, gr)
-    g0 = max(g0, 0.0)  # round-off after the switch into this mode
-    g1, d1 = _curved_at(curved, mode, k, tau, C, S, hs, om, n, u, f0, u1, f1, pp, mem, gr, us,
-                        1.0, pm, TW)
-    sl = hs * (abs(d0) + abs(d1))
-    if g1 >= 0.0 and min(g0, g1) - 2.0 * _HERM_SLOPE * sl > 1e-9 * (abs(g0) + abs(g1) + sl):
-        return 2.0, 2.0
+def _curved_scan(curved, mode, k, tau, C, S, hs, om, n, u, f0, u1, f1, pp, mem, gr, us, stack,
+                 end, s_best, pm, TW):
+    """The first piece of [0, end] (fractions of the step, left to right) that holds a
+    negative value of curved guard k: (a, b, g(b)) with g(a) >= 0 > g(b), or (-1, -1, 0).
+    A piece passes when the cubic Hermite of (g, g') at its ends, less four times the quartic
+    error bound estimated from the true g at its midpoint, stays >= 0 (``_herm_clear``); else
+    it is halved (at most CURVED_DEPTH times); on a piece whose end is negative the Hermite's
+    interior minima are tried first."""
+    ga, da = _curved_at(curved, mode, k, tau, C, S, hs, om, n, u, f0, u1, f1, pp, mem, gr, us,
+                        0.0, pm, TW)
+    ga = max(ga, 0.0)  # round-off after the switch into this mode
+    gb, db = _curved_at(curved, mode, k, tau, C, S, hs, om, n, u, f0, u1, f1, pp, mem, gr, us,
+                        end, pm, TW)
     a = 0.0
-    b = 1.0
-    ga, da, gb, db = g0, d0, g1, d1
+    b = end
     depth = 0
     top = 0
-    lo = 2.0
-    hi = 2.0
-    ghi = 0.0
     while True:
         if a >= s_best:
-            return 2.0, 2.0
+            return -1.0, -1.0, 0.0
         L = (b - a) * hs
         if gb < 0.0:
-            lo = a
-            hi = b
-            ghi = gb
             b1, b2, b3 = herm_coeffs(ga, da, gb, db, L)
             r1, r2 = quad_roots01(b1, 2.0 * b2, 3.0 * b3)
             for q in (min(r1, r2), max(r1, r2)):
@@ -544,10 +532,8 @@ def _curved_exit(curved, mode, k, tau, C, S, hs, om, n, u, f0, u1, f1, pp, mem, 
                     gq, _ = _curved_at(curved, mode, k, tau, C, S, hs, om, n, u, f0, u1, f1,
                                        pp, mem, gr, us, sq, pm, TW)
                     if gq < 0.0:
-                        hi = sq
-                        ghi = gq
-                        break
-            break
+                        return a, sq, gq
+            return a, b, gb
         m = 0.5 * (a + b)
         gm, dm = _curved_at(curved, mode, k, tau, C, S, hs, om, n, u, f0, u1, f1, pp, mem, gr,
                             us, m, pm, TW)
@@ -567,12 +553,9 @@ def _curved_exit(curved, mode, k, tau, C, S, hs, om, n, u, f0, u1, f1, pp, mem, 
                 depth += 1
                 continue
             if gm < 0.0:
-                lo = a
-                hi = m
-                ghi = gm
-                break
+                return a, m, gm
         if top == 0:
-            return 2.0, 2.0
+            return -1.0, -1.0, 0.0
         top -= 1
         a = b
         ga = gb
@@ -581,20 +564,52 @@ def _curved_exit(curved, mode, k, tau, C, S, hs, om, n, u, f0, u1, f1, pp, mem, 
         gb = stack[top, 1]
         db = stack[top, 2]
         depth = int(stack[top, 4])
-    if lo >= s_best:
+
+
+@nb.njit(cache=True)
+def _curved_exit(curved, mode, k, tau, C, S, hs, om, n, u, f0, u1, f1, pp, mem, gr, us, stack,
+                 s_best, pm, TW):
+    """Exit test of curved guard k over the step just taken: (lo, hi) bracketing its first
+    crossing to S_TOL of the step (g(lo) >= 0 > g(hi)), (2.0, 2.0) when it stays >= 0 up to
+    ``s_best`` (an earlier crossing of another guard), (-1.0, -1.0) when location fails.
+
+    A step whose ends clear zero by twice the Hermite slope bound is passed at once. Otherwise
+    the first negative piece (``_curved_scan``) is bracketed, the crossing located by
+    Illinois on the true g, and [0, lo] scanned again, so that a dip and a return before it
+    are found too (the first crossing, grazing dips included)."""
+    g0, d0 = _curved_rate(curved, mode, k, tau, C, S, n, u, f0, pp, mem, gr)
+    g0 = max(g0, 0.0)  # round-off after the switch into this mode
+    g1, d1 = _curved_at(curved, mode, k, tau, C, S, hs, om, n, u, f0, u1, f1, pp, mem, gr, us,
+                        1.0, pm, TW)
+    sl = hs * (abs(d0) + abs(d1))
+    if g1 >= 0.0 and min(g0, g1) - 2.0 * _HERM_SLOPE * sl > 1e-9 * (abs(g0) + abs(g1) + sl):
         return 2.0, 2.0
-    glo = _curved_at(curved, mode, k, tau, C, S, hs, om, n, u, f0, u1, f1, pp, mem, gr, us,
-                     lo, pm, TW)[0] if lo > 0.0 else g0
-    side = 0
-    for _ in range(200):
-        if hi - lo <= S_TOL:
+    lo, hi, ghi = _curved_scan(curved, mode, k, tau, C, S, hs, om, n, u, f0, u1, f1, pp, mem,
+                               gr, us, stack, 1.0, s_best, pm, TW)
+    if hi < 0.0:
+        return 2.0, 2.0
+    for _ in range(8):
+        if lo >= s_best:
+            return 2.0, 2.0
+        glo = _curved_at(curved, mode, k, tau, C, S, hs, om, n, u, f0, u1, f1, pp, mem, gr,
+                         us, lo, pm, TW)[0] if lo > 0.0 else g0
+        side = 0
+        for _ in range(200):
+            if hi - lo <= S_TOL:
+                break
+            sm = illinois_point(lo, hi, glo, ghi)
+            gm = _curved_at(curved, mode, k, tau, C, S, hs, om, n, u, f0, u1, f1, pp, mem, gr,
+                            us, sm, pm, TW)[0]
+            lo, hi, glo, ghi, side = illinois_update(lo, hi, glo, ghi, side, sm, gm)
+        if hi - lo > S_TOL:
+            return -1.0, -1.0
+        if not lo > 0.0:
             break
-        sm = illinois_point(lo, hi, glo, ghi)
-        gm = _curved_at(curved, mode, k, tau, C, S, hs, om, n, u, f0, u1, f1, pp, mem, gr, us,
-                        sm, pm, TW)[0]
-        lo, hi, glo, ghi, side = illinois_update(lo, hi, glo, ghi, side, sm, gm)
-    if hi - lo > S_TOL:
-        return -1.0, -1.0
+        a2, b2, g2 = _curved_scan(curved, mode, k, tau, C, S, hs, om, n, u, f0, u1, f1, pp, mem,
+                                  gr, us, stack, lo, lo, pm, TW)
+        if b2 < 0.0:
+            break
+        lo, hi, ghi = a2, b2, g2
     return lo, hi
 
 
@@ -1163,6 +1178,7 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
 
                 # ---- exit test for every guard; earliest crossing located by Illinois ----
                 s_best = 2.0
+                s_lo = 0.0  # the located crossing lies in [s_lo, s_best] (fractions)
                 En = -1.0  # energy norm of a closed-form piece, when needed
                 for k in range(ng):
                     if pm and not (ncv > 0 and math.isnan(G[k, n])):
@@ -1173,6 +1189,7 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
                             break
                         if hi < s_best * hs:
                             s_best = hi / hs
+                            s_lo = lo / hs
                             k_tr = k
                         continue
                     if ncv > 0 and math.isnan(G[k, n]):
@@ -1183,6 +1200,7 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
                             break
                         if hi < s_best:
                             s_best = hi
+                            s_lo = lo
                             k_tr = k
                         continue
                     g0 = _gval(G, k, n, u, C, S)
@@ -1277,6 +1295,7 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
                         break
                     if hi < s_best:
                         s_best = hi
+                        s_lo = lo
                         k_tr = k
                 if code != st.OK:
                     break
@@ -1293,20 +1312,35 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
                                                    u1, f1, TW)
                             if ncv > 0 and math.isnan(G[k_tr, n]):
                                 # a curved guard: Newton on the true g of the retaken step's
-                                # end (the interpolant is a cubic, the step 5th order)
+                                # end (the interpolant is a cubic, the step 5th order), kept
+                                # within the located bracket (and 1e-4 of the step around
+                                # it) and only while |g| decreases
                                 hs_full = hs / s_best
+                                t_lo = max(s_lo - 1e-4, 0.0) * hs_full
+                                t_hi = min(s_best + 1e-4, 1.0) * hs_full
+                                gn, dn = _curved_rate(curved, mode, k_tr, tau + hs, C1, S1, n,
+                                                      u1, f1, pp, mem, gr)
                                 for _ in range(4):
-                                    gn, dn = _curved_rate(curved, mode, k_tr, tau + hs, C1, S1,
-                                                          n, u1, f1, pp, mem, gr)
                                     if not dn < 0.0:
                                         break
                                     dh = -gn / dn
-                                    if not (abs(dh) > 1e-15 * hs and 0.0 < hs + dh < hs_full):
+                                    if not (abs(dh) > 1e-15 * hs and t_lo < hs + dh < t_hi):
                                         break
+                                    h_old = hs
                                     hs += dh
                                     err2, C1, S1 = _retake(field, pm, mode, tau, C, S, hs, om, n,
                                                            u, f0, pp, mem, rtol, atol, us, k1,
                                                            k2, k3, k4, k5, u1, f1, TW)
+                                    g2, d2 = _curved_rate(curved, mode, k_tr, tau + hs, C1, S1,
+                                                          n, u1, f1, pp, mem, gr)
+                                    if not abs(g2) < abs(gn):  # no better: back, and stop
+                                        hs = h_old
+                                        err2, C1, S1 = _retake(field, pm, mode, tau, C, S, hs,
+                                                               om, n, u, f0, pp, mem, rtol,
+                                                               atol, us, k1, k2, k3, k4, k5,
+                                                               u1, f1, TW)
+                                        break
+                                    gn, dn = g2, d2
                         if not math.isfinite(u1[0]):
                             code = st.NON_FINITE
                             break

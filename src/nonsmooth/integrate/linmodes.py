@@ -31,7 +31,8 @@ from .roots import illinois_point, illinois_update, quad_roots01
 
 THETA_POLY = 2.0  # rho L on a full piece
 N_TAYLOR = 28  # terms beyond the constant one
-POLY_DEPTH = 30  # halvings of a piece in its exit test
+POLY_DEPTH = 30  # halvings of a piece in its exit test (<= hybrid.SCAN_DEPTH: its stack)
+X_SAMPLES = 4  # samples of V per piece for the extrema of X
 
 
 @nb.njit(cache=True)
@@ -164,45 +165,34 @@ def _clear(ga, da, gb, db, L, M4):
 
 
 @nb.njit(cache=True)
-def poly_exit(c, L, s_best, stack, tol):
-    """Exit test of a guard that is the polynomial ``c`` in s on a piece [0, L]: (lo, hi)
-    bracketing its first crossing to ``tol`` (times, g(lo) >= 0 > g(hi)), (2L, 2L) when it
-    stays >= 0 up to ``s_best`` (a time: an earlier crossing of another guard), (-1, -1)
-    when location fails. Pieces are taken left to right; one is passed when its Hermite of
-    (g, g') less the coefficients' bound of g'''' clears zero (certified), else halved (at
-    most POLY_DEPTH times); on a piece whose end is negative the Hermite's interior minima
-    are tried first, so the crossing found is the first one."""
+def _poly_scan(c, end, s_best, stack):
+    """The first piece of [0, end] (left to right) that holds a negative value of the
+    polynomial ``c``: (a, b, g(b)) with g(a) >= 0 > g(b), or (-1, -1, 0) when g >= 0 is
+    certified up to min(end, s_best). A piece passes when its Hermite of (g, g') less the
+    coefficients' bound of the fourth derivative clears zero; else it is halved (at most
+    POLY_DEPTH times); on a piece whose end is negative the Hermite's interior minima are
+    tried first."""
     ga, da = _pval(c, 0.0)
     ga = max(ga, 0.0)  # round-off after the switch into this mode
-    gb, db = _pval(c, L)
-    M4 = _m4(c, L)
-    if _clear(ga, da, gb, db, L, M4):
-        return 2.0 * L, 2.0 * L
+    gb, db = _pval(c, end)
+    M4 = _m4(c, end)
     a = 0.0
-    b = L
+    b = end
     depth = 0
     top = 0
-    lo = -1.0
-    hi = -1.0
-    ghi = 0.0
     while True:
         if a >= s_best:
-            return 2.0 * L, 2.0 * L
+            return -1.0, -1.0, 0.0
         w = b - a
         if gb < 0.0:
-            lo = a
-            hi = b
-            ghi = gb
             b1, b2, b3 = herm_coeffs(ga, da, gb, db, w)
             r1, r2 = quad_roots01(b1, 2.0 * b2, 3.0 * b3)
             for q in (min(r1, r2), max(r1, r2)):
                 if 0.0 < q < 1.0 and 2.0 * b2 + 6.0 * b3 * q > 0.0:
                     gq, _ = _pval(c, a + q * w)
                     if gq < 0.0:
-                        hi = a + q * w
-                        ghi = gq
-                        break
-            break
+                        return a, a + q * w, gq
+            return a, b, gb
         if not _clear(ga, da, gb, db, w, M4 if depth == 0 else _m4(c, b)):
             if depth < POLY_DEPTH:
                 stack[top, 0] = b
@@ -216,12 +206,9 @@ def poly_exit(c, L, s_best, stack, tol):
                 continue
             gm, _ = _pval(c, 0.5 * (a + b))
             if gm < 0.0:
-                lo = a
-                hi = 0.5 * (a + b)
-                ghi = gm
-                break
+                return a, 0.5 * (a + b), gm
         if top == 0:
-            return 2.0 * L, 2.0 * L
+            return -1.0, -1.0, 0.0
         top -= 1
         a = b
         ga = gb
@@ -230,44 +217,70 @@ def poly_exit(c, L, s_best, stack, tol):
         gb = stack[top, 1]
         db = stack[top, 2]
         depth = int(stack[top, 4])
-    if lo >= s_best:
+
+
+@nb.njit(cache=True)
+def poly_exit(c, L, s_best, stack, tol):
+    """Exit test of a guard that is the polynomial ``c`` in s on a piece [0, L]: (lo, hi)
+    bracketing its first crossing to ``tol`` (times, g(lo) >= 0 > g(hi)), (2L, 2L) when it
+    stays >= 0 up to ``s_best`` (a time: an earlier crossing of another guard), (-1, -1)
+    when location fails. The first negative piece (``_poly_scan``) is bracketed and the
+    crossing located by Illinois; then [0, lo] is scanned again, so that a dip and a return
+    before it are found too (the first crossing, as ``hybrid._first_crossing`` ensures for
+    affine guards)."""
+    ga, da = _pval(c, 0.0)
+    gb, db = _pval(c, L)
+    if _clear(max(ga, 0.0), da, gb, db, L, _m4(c, L)):
         return 2.0 * L, 2.0 * L
-    glo = _pval(c, lo)[0] if lo > 0.0 else max(_pval(c, 0.0)[0], 0.0)
-    side = 0
-    for _ in range(200):
-        if hi - lo <= tol:
+    lo, hi, ghi = _poly_scan(c, L, s_best, stack)
+    if hi < 0.0:
+        return 2.0 * L, 2.0 * L
+    for _ in range(8):
+        if lo >= s_best:
+            return 2.0 * L, 2.0 * L
+        glo = _pval(c, lo)[0] if lo > 0.0 else max(ga, 0.0)
+        side = 0
+        for _ in range(200):
+            if hi - lo <= tol:
+                break
+            sm = illinois_point(lo, hi, glo, ghi)
+            gm = _pval(c, sm)[0]
+            lo, hi, glo, ghi, side = illinois_update(lo, hi, glo, ghi, side, sm, gm)
+        if hi - lo > tol:
+            return -1.0, -1.0
+        if not lo > 0.0:
             break
-        sm = illinois_point(lo, hi, glo, ghi)
-        gm = _pval(c, sm)[0]
-        lo, hi, glo, ghi, side = illinois_update(lo, hi, glo, ghi, side, sm, gm)
-    if hi - lo > tol:
-        return -1.0, -1.0
+        a2, b2, g2 = _poly_scan(c, lo, lo, stack)  # an earlier crossing inside [0, lo]?
+        if b2 < 0.0:
+            break
+        lo, hi, ghi = a2, b2, g2
     return lo, hi
 
 
 @nb.njit(cache=True)
 def poly_x_extrema(TW, hs, xmax, xmin):
-    """(xmax, xmin) with the interior extrema of X = z[0] on the piece [0, hs] (where
-    V = z[0]' changes sign; a piece spans at most THETA_POLY / omega of the fastest rate, so
-    at most one sign change is expected)."""
-    v0 = poly_component(TW, 0, 0.0)[1]
-    v1 = poly_component(TW, 0, hs)[1]
-    if v0 * v1 < 0.0:
-        lo, hi = 0.0, hs
-        glo, ghi = v0, v1
-        if v0 < 0.0:  # keep g >= 0 at lo for illinois_update
-            glo, ghi = -v0, -v1
-        sg = 1.0 if v0 >= 0.0 else -1.0
-        side = 0
-        for _ in range(100):
-            if hi - lo <= 1e-15 * hs:
-                break
-            sm = illinois_point(lo, hi, glo, ghi)
-            gm = sg * poly_component(TW, 0, sm)[1]
-            lo, hi, glo, ghi, side = illinois_update(lo, hi, glo, ghi, side, sm, gm)
-        x = poly_component(TW, 0, 0.5 * (lo + hi))[0]
-        xmax = max(xmax, x)
-        xmin = min(xmin, x)
+    """(xmax, xmin) with the interior extrema of X = z[0] on the piece [0, hs]: where
+    V = z[0]' changes sign between X_SAMPLES + 1 points (a piece spans THETA_POLY = 2 of the
+    fastest rate: at most one sign change is expected between two of them)."""
+    va = poly_component(TW, 0, 0.0)[1]
+    for q in range(1, X_SAMPLES + 1):  # V at X_SAMPLES points: each sign change an extremum
+        a = (q - 1) * hs / X_SAMPLES
+        b = q * hs / X_SAMPLES
+        vb = poly_component(TW, 0, b)[1]
+        if va * vb < 0.0:
+            sg = 1.0 if va >= 0.0 else -1.0  # g = sg V >= 0 at the lower end
+            lo, hi, glo, ghi = a, b, sg * va, sg * vb
+            side = 0
+            for _ in range(100):
+                if hi - lo <= 1e-15 * hs:
+                    break
+                sm = illinois_point(lo, hi, glo, ghi)
+                gm = sg * poly_component(TW, 0, sm)[1]
+                lo, hi, glo, ghi, side = illinois_update(lo, hi, glo, ghi, side, sm, gm)
+            x = poly_component(TW, 0, 0.5 * (lo + hi))[0]
+            xmax = max(xmax, x)
+            xmin = min(xmin, x)
+        va = vb
     return xmax, xmin
 
 

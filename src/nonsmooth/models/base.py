@@ -12,7 +12,10 @@ signatures of :mod:`nonsmooth.integrate.contract`). It declares
   T = 2 pi / omega frames time (output intervals, the stroboscopic section at t = t_s + kT, and
   the local time that restarts at t_s every period; t_s = section_phase / omega, 0 by
   default, so t runs over [t_s, t_s + T)). Functions receive t and (c, s) = (cos omega t,
-  sin omega t), so they never evaluate a cosine;
+  sin omega t), so they never evaluate a cosine. A self-excited system may declare no forcing
+  (``omega=None``): its time unit is then 2 pi (c, s are cos t, sin t and mean nothing), the
+  stroboscopic analyses refuse it in one line, and it is studied on section surfaces
+  (``limit_cycle``, ``surface_basins``, ``equilibria``, see :mod:`nonsmooth.analysis.autonomous`);
 * the **state** u of dimension n >= 2 (``state_names``; u[0] is the displacement X that
   analyses and plots show, u[1] its rate V), and ``n_memory`` slots of discrete memory ``mem``
   (e.g. the entry velocity X_dot_a of the paper's eq. 13a) that transitions may write;
@@ -45,9 +48,10 @@ signatures of :mod:`nonsmooth.integrate.contract`). It declares
       stator has g = (delta^2 - x^2 - y^2) / (2 delta) >= 0 in free flight. Curved guards
       are located on the step's interpolant like affine ones, grazing dips included (the
       true g is evaluated at the interpolant's critical points), and their gradient enters
-      the saltation matrix; a mode with a curved guard is integrated by RKF45 (no closed form).
+      the saltation matrix; a mode with a curved guard is not taken in the oscillator's closed
+      form (a general linear mode, kind 2 of ``linear``, is).
   ``linear(mode, p, out) -> 0, 1 or 2`` (optional)
-      1 (n = 2) if the mode is X'' + c X' + k X = F cos(omega t) + b with k > 0 (out[0:4] =
+      1 (n = 2) if the mode is X'' + c X' + k X = F cos(omega t) + b with k > 0, c >= 0 (out[0:4] =
       k, c, b, F); 2 (any n, any stiffness) if it is u' = A u + b + f_c cos(omega t) +
       f_s sin(omega t) with constant coefficients (out[0:n*n] = A row-major, then b, f_c,
       f_s, n each; ``out`` has max(4, n^2 + 3n) slots): with ``closed_form=True`` the method then propagates it in closed form
@@ -197,11 +201,18 @@ class ModelParams(ParamsBase):
         return self.model.params(**{**self.as_dict(), **changes})
 
     def pack(self) -> np.ndarray:
-        return np.array([self._values[n] for n in self.model.param_names], dtype=np.float64)
+        """The values in the order of ``model.param_names``; a model without forcing
+        (``omega=None``) gets one more slot, its time unit's frequency 1 (``frame_index``)."""
+        vals = [self._values[n] for n in self.model.param_names]
+        if self.model.omega is None:
+            vals.append(1.0)
+        return np.array(vals, dtype=np.float64)
 
     @property
     def period(self) -> float:
-        """Forcing period T = 2 pi / omega."""
+        """Forcing period T = 2 pi / omega (a model without forcing: its time unit 2 pi)."""
+        if self.model.omega is None:
+            return 2.0 * math.pi
         return 2.0 * math.pi / self._values[self.model.omega]
 
     def attrs(self) -> dict:
@@ -268,7 +279,7 @@ class Model:
     state_names: tuple
     mode_names: tuple
     methods: dict
-    omega: str = "omega"
+    omega: str | None = "omega"
     forcing_amplitude: str | None = "F0"
     n_memory: int = 0
     state_units: tuple = ()
@@ -293,7 +304,10 @@ class Model:
         names = [p.name for p in self.parameters]
         if len(set(names)) != len(names):
             raise bad("parameter names must be unique")
-        if self.omega not in names:
+        if self.omega is None:
+            if self.forcing_amplitude is not None:
+                raise bad("a model without forcing (omega=None) has no forcing_amplitude")
+        elif self.omega not in names:
             raise bad(f"the forcing frequency {self.omega!r} must be a parameter")
         n = len(self.state_names)
         if n < 2:
@@ -320,6 +334,18 @@ class Model:
     @property
     def param_names(self) -> tuple:
         return tuple(p.name for p in self.parameters)
+
+    @property
+    def frame_index(self) -> int:
+        """Where the kernels read the frequency that frames time (T = 2 pi / omega): the
+        forcing frequency's slot, or for a model without forcing the extra slot that
+        ``pack`` appends (1: a time unit of 2 pi)."""
+        return len(self.parameters) if self.omega is None else self.index[self.omega]
+
+    @property
+    def autonomous(self) -> bool:
+        """True for a model that declares no forcing (``omega=None``)."""
+        return self.omega is None
 
     @property
     def index(self) -> dict:
@@ -562,7 +588,7 @@ def _check_curved(model, m, fns, mode, k, p, u, mem, bad, call_curved):
         raise bad(f"guards marks surface {k} of mode {name} curved, but the method has no "
                   "curved function")
     n = model.n
-    om = float(p[model.index[model.omega]])
+    om = float(p[model.frame_index])
 
     def g_at(t, uu):
         grad = np.zeros(n + 1)

@@ -109,7 +109,8 @@ def model_from_equations(name: str, *, states, parameters, modes: dict | None = 
     description=..., flow_is_homeomorphism=...), "smooth": dict(...)}`` instead of ``modes``,
     ``guards``, ``initial`` and ``method``; the model's modes are those of all methods, in
     order of appearance (a mode of the same name is one mode). ``omega``: the forcing
-    frequency parameter. ``contact_modes``: mode names that count as contact. Other keywords
+    frequency parameter (None: a self-excited system without forcing, whose equations do not
+    use t; see ``Model.omega``). ``contact_modes``: mode names that count as contact. Other keywords
     (``state_units``, ``state_long_names``, ``presets``, ``contact_name``, ``lines``,
     ``references``, ``check``, ...) go to :class:`Model` as they are.
 
@@ -142,7 +143,7 @@ def model_from_equations(name: str, *, states, parameters, modes: dict | None = 
             raise bad(f"{nm!r} cannot name a state or parameter (reserved or not an identifier)")
     if len(set(states + pnames)) != len(states) + len(pnames):
         raise bad("state and parameter names must all differ")
-    if omega not in pnames:
+    if omega is not None and omega not in pnames:
         raise bad(f"the forcing frequency {omega!r} must be a parameter")
     mode_names = tuple(dict.fromkeys(m for spec in methods.values()
                                      for m in (spec.get("modes") or {})))
@@ -151,7 +152,8 @@ def model_from_equations(name: str, *, states, parameters, modes: dict | None = 
     sym = {nm: sp.Symbol(nm, real=True) for nm in states + pnames}
     t = sp.Symbol("t", real=True)
     C, S = sp.Dummy("cos_omega_t", real=True), sp.Dummy("sin_omega_t", real=True)
-    ctx = _Context(sp, sym, t, C, S, sym[omega], set(states), name)
+    ctx = _Context(sp, sym, t, C, S, sym[omega] if omega is not None else None, set(states),
+                   name)
     built = {}
     for mname, spec in methods.items():
         unknown = set(spec) - {"modes", "guards", "initial", "rtol", "atol", "description",
@@ -345,6 +347,11 @@ class _Context:
             if not any(c is sp.true for _, c in pw.args):
                 raise self.bad(f"{where}: a Piecewise needs a last branch (value, True)")
         w, t = self.omega, self.t
+        if w is None:
+            if t in expr.free_symbols:
+                raise self.bad(f"{where}: the model declares no forcing (omega=None), so its "
+                               f"equations cannot use the time t")
+            return expr
         return expr.subs({self.sp.cos(w * t): self.C, self.sp.sin(w * t): self.S})
 
     def condition(self, text, where):
@@ -388,17 +395,20 @@ class _Context:
                 sp.simplify(sp.diff(g, v)) == 0 for v in var + [self.t]):
             raise self.bad(f"{where}: the surface {g} has a zero gradient (it depends on "
                            f"neither the state nor the time)")
-        if g.has(sp.Piecewise, sp.sign, sp.floor, sp.Abs, sp.Min, sp.Max):
-            raise self.bad(f"{where}: the surface {g} is not smooth (Piecewise, sign, floor, "
-                           f"Abs, Min or Max): write one surface per smooth piece")
-        if self.t in g.free_symbols:
+        def curved(g):
+            if g.has(sp.Piecewise, sp.sign, sp.floor, sp.Abs, sp.Min, sp.Max):
+                raise self.bad(f"{where}: the surface {g} is not smooth (Piecewise, sign, "
+                               f"floor, Abs, Min or Max): write one surface per smooth piece")
             return g
+
+        if self.t in g.free_symbols:
+            return curved(g)
         coef = [sp.diff(g, v) for v in var]
         const = g.subs({v: 0 for v in var})
         rest = sp.simplify(g - sum((c * v for c, v in zip(coef, var)), const))
         if any(c.free_symbols & set(var) for c in coef) or rest.free_symbols & set(var) \
                 or rest != 0:
-            return g  # curved
+            return curved(g)
         n = len(self.states)
         return coef[:n] + [const, coef[n], coef[n + 1]]
 
@@ -515,7 +525,8 @@ def _source(sp, ctx, states, pnames, mode_names, own, fields, rows, branches, in
     unpack_u = [f"    _x{i} = u[{i}]" for i in range(n)]
     # t: the time within the forcing period, 0 <= t < T, whatever the section phase (the
     # kernel's periods run from t_s = phase / omega, so t < t_s + T < 2 T)
-    iw = pnames.index(ctx.omega.name)
+    # (a model without forcing: the slot its packed parameters append, its time unit's 1)
+    iw = pnames.index(ctx.omega.name) if ctx.omega is not None else len(pnames)
     exprs = [e for f in fields.values() for e in f] + [c for c, _ in init] + [
         e for brs in branches.values() for br in brs for c, _, rs in br
         for e in (c, *rs.values())] + [
@@ -572,7 +583,7 @@ def _source(sp, ctx, states, pnames, mode_names, own, fields, rows, branches, in
         # g, its gradient in the state and its partial time derivative at fixed u (cos and
         # sin(omega t) turn with t: d/dt = d/dt + omega (-s d/dc + c d/ds))
         out = []
-        w = ctx.omega
+        w = ctx.omega if ctx.omega is not None else sp.Integer(0)
         for k, row in enumerate(rows.get(m, ())):
             if isinstance(row, list):
                 continue
@@ -622,7 +633,7 @@ def _source(sp, ctx, states, pnames, mode_names, own, fields, rows, branches, in
         out = []
         if osc is not None:  # the oscillator's closed form where k > 0
             out += [f"out[{i}] = float({code(v)})" for i, v in enumerate(osc)]
-            out += ["if out[0] > 0.0:", "    return 1"]
+            out += ["if out[0] > 0.0 and out[1] >= 0.0:", "    return 1"]
         flat = [a for row in A for a in row] + list(b) + list(fc) + list(fs)
         return out + [f"out[{i}] = float({code(v)})" for i, v in enumerate(flat)] + ["return 2"]
 

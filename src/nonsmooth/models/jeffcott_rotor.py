@@ -20,7 +20,8 @@ it whirls):
 ``method="exact"``: two modes, ``free`` (g = delta^2 - X^2 - Y^2 >= 0) and ``rub``
 (g = X^2 + Y^2 - delta^2 >= 0), switched at the located crossing of the circle; the contact
 force is continuous there, its Jacobian is not (the saltation matrix is the identity, the
-tangent dynamics change field). RKF45 at rtol 1e-12.
+tangent dynamics change field). The free whirl is linear: in closed form (the series of
+``integrate.linmodes``); the rub by RKF45 at rtol 1e-12.
 
 ``method="smooth"``: one vector field, the contact force regularised over a band eta:
 k_s (r - delta)_+ is replaced by k_s eta softplus((r - delta) / eta), which tends to the exact
@@ -78,7 +79,8 @@ MODEL = model_from_equations(
                     "rub": [("X**2 + Y**2 - delta**2", "free")]},
             initial=[("X**2 + Y**2 > delta**2", "rub")],
             description="rub on the stator switched at the located crossing of the circle "
-                        "r = delta (a curved guard); RKF45 at rtol 1e-12"),
+                        "r = delta (a curved guard); free whirl in closed form, rub RKF45 at "
+                        "rtol 1e-12"),
         "smooth": dict(
             modes={m: ["V", f"{FREE_X} - {SMOOTH_PRESS}*(X - mu*Y)",
                        "W", f"{FREE_Y} - {SMOOTH_PRESS}*(mu*X + Y)"] for m in ("free", "rub")},

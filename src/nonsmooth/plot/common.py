@@ -88,17 +88,17 @@ def check_show(show, names) -> tuple | None:
     return tuple(parts)
 
 
-def shown_components(ds, show, prefix: str = ""):
+def shown_components(ds, show, prefix: str = "", suffix: str = ""):
     """The two state components a figure shows: ``show`` (None: the first two), as
     (index a, index b, label a, label b, values of a, values of b) from the dataset's
-    component variables (``<prefix>X``, ``<prefix>V``, then one per further component, see
-    ``io.components``); indices into the model's states."""
+    component variables (``<prefix>X<suffix>``, ``<prefix>V<suffix>``, then one per further
+    component, see ``io.components``); indices into the model's states."""
     from ..io import component_names
     labels = state_labels(ds)
     names = str(ds.attrs.get("state_names", "X V")).split()
     pair = check_show(show, names) or tuple(names[:2])
     a, b = names.index(pair[0]), names.index(pair[1])
-    var = [f"{prefix}{nm}" for nm in component_names(names)]
+    var = [f"{prefix}{nm}{suffix}" for nm in component_names(names)]
     la = labels[a] if a < len(labels) else f"${names[a]}$"
     lb = labels[b] if b < len(labels) else f"${names[b]}$"
     return a, b, la, lb, ds[var[a]].values, ds[var[b]].values

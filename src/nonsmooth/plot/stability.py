@@ -7,7 +7,7 @@ from __future__ import annotations
 import numpy as np
 
 from .common import (MODE_COLORS, draw_model_lines, model_of, new_figure, param_title, state_labels,
-                     scatter_by_region)
+                     scatter_by_region, shown_components)
 
 
 def _figure(ax, figsize):
@@ -65,22 +65,26 @@ def plot_lyapunov(ds, ax=None):
     return fig
 
 
-def plot_orbit(ds, ax=None):
+def plot_orbit(ds, ax=None, show=None):
     """The periodic orbit's phase portrait V(X) coloured by the model's modes, its section
     points (t = jT) marked, the model's lines of X (support: X = 1), and the Floquet
-    multipliers with the verdict in a text box."""
+    multipliers with the verdict in a text box. ``show`` = (a, b) (or "a,b"): the plane of
+    two other state components instead."""
     fig, ax, own = _figure(ax, (6.8, 5.2))
-    X, V, R = ds["X"].values, ds["V"].values, ds["mode"].values
+    ia, ib, la, lb, X, V = shown_components(ds, show)
+    Xs, Vs = shown_components(ds, show, suffix="_section")[4:]
+    R = ds["mode"].values
     a = ds.attrs
     k = int(a.get("k", ds.sizes.get("point", 1)))
     ok = np.isfinite(X) & np.isfinite(V)
     ax.plot(X[ok], V[ok], color="0.55", lw=0.8, zorder=1)
     scatter_by_region(ax, X[ok], V[ok], R[ok], s=4, model=model_of(ds), zorder=2)
-    ax.scatter(ds["X_section"].values, ds["V_section"].values, s=60, facecolor="w",
-               edgecolor="k", lw=1.5, zorder=3, label=r"section $t = jT$")
-    draw_model_lines(ax, ds, "v", band_edges=False)
-    ax.set_xlabel(state_labels(ds)[0])
-    ax.set_ylabel(state_labels(ds)[1])
+    ax.scatter(Xs, Vs, s=60, facecolor="w", edgecolor="k", lw=1.5, zorder=3,
+               label=r"section $t = jT$")
+    if ia == 0:
+        draw_model_lines(ax, ds, "v", band_edges=False)
+    ax.set_xlabel(la)
+    ax.set_ylabel(lb)
     ax.grid(True, lw=0.3, alpha=0.5)
     ax.legend(loc="lower left", fontsize=7, markerscale=1.5)
     found = a.get("status", "") == "converged"

@@ -181,6 +181,8 @@ def basins(params: ParamsBase, *, x=(-3.0, 3.0), v=(-3.0, 3.0), grid=400, method
     each round is a chunk, continued from the attractors the rounds before it found, so the
     rounds run one after the other (on Dask: one worker at a time, with its threads).
     """
+    from ...simulate import check_forced
+    check_forced(params, "basins")
     from ...sweep import progress_callback
     progress = progress_callback(progress, "basins")
     from ...chunks import Plan, check_engine, execute, plan_solver
