@@ -211,3 +211,31 @@ def test_x_and_v_quantities_carry_the_models_units():
                                  method="exact", lyapunov=False)
     assert bif.X.attrs["units"] == "m" and bif.max_X.attrs["units"] == "m"
     assert ns.preset("table3").model.state_units == ("1", "1/s")  # the paper's, unchanged
+
+
+def test_basins_on_any_two_components_against_single_runs(tmp_path, capsys):
+    """Basins on the grid (X, Y) with V = W = 0 (a four-state model: no certificate, every point
+    runs until its section repeats): each grid point's label is the attractor that
+    ``poincare`` reaches from the same full start, and the axes are named in the result."""
+    ds = ns.basins(P, x=(-0.6, 0.4), v=(-0.8, 0.8), grid=3, method="exact", axes=("X", "Y"),
+                   max_periods=2000)
+    assert ds.attrs["axes"] == "X Y" and ds.v0.attrs["long_name"] == "initial Y"
+    assert ds.attrs["certified_cells"] == 0 and float(ds.undecided_fraction) == 0.0
+    for i, x in enumerate(ds.x0.values):
+        for j, y in enumerate(ds.v0.values):
+            po = ns.poincare(P, transient=600, record=4, method="exact", u0=[x, 0.0, y, 0.0],
+                             lyapunov=False)
+            k = int(ds.label[i, j])
+            pts = np.stack([ds.attractor_X[k].values, ds.attractor_V[k].values], axis=1)
+            last = np.array([float(po.X[-1]), float(po.V[-1])])
+            assert np.nanmin(np.abs(pts - last).max(axis=1)) < 1e-6
+    from cli_helpers import one_line, run_cli
+    out = tmp_path / "b.nc"
+    code, stdout, _ = run_cli(["basins", "-m", "impact_2dof", "--method", "exact", "--axes",
+                               "X,Y", "--u0", "W=0.1", "--x", "-0.6", "0.4", "--v", "-0.8",
+                               "0.8", "--grid", "2", "-o", str(out)], capsys)
+    assert code == 0 and "attractor" in stdout
+    code, _, err = run_cli(["basins", "-m", "impact_2dof", "--axes", "X,Q", "-o",
+                            str(tmp_path / "c.nc")], capsys)
+    assert code == 2
+    one_line(err, "axes: unknown component 'Q'")

@@ -57,6 +57,25 @@ def check_forced(params, who: str) -> None:
                              f"surface_basins, equilibria) or simulate")
 
 
+def component_pair(pair, names, field: str) -> tuple | None:
+    """``pair`` (None, "X,Y" or a pair of component names) as a pair of names among ``names``
+    (the model's ``state_names``); a one-line ParameterError naming ``field`` otherwise."""
+    if pair is None:
+        return None
+    try:
+        parts = [t.strip() for t in pair.split(",")] if isinstance(pair, str) else list(pair)
+    except TypeError:
+        parts = []
+    if len(parts) != 2:
+        raise ParameterError(f"{field}: expected two state components (e.g. X,V), got "
+                             f"{pair!r}")
+    for name in parts:
+        if name not in names:
+            raise ParameterError(f"{field}: unknown component {name!r} (the model has "
+                                 f"{', '.join(names)})")
+    return tuple(parts)
+
+
 def initial_u(model, x0=0.0, v0=0.0, u0=None) -> np.ndarray:
     """The initial state u (all ``model.n`` components) from ``x0``, ``v0`` (u[0], u[1]; the
     other components 0) or from ``u0``: a sequence of n numbers in the order of

@@ -9,7 +9,7 @@ import typer
 
 from .app import app
 from .common import (DEFAULT_MODEL, SectionPhaseOpt, AtolOpt, DaskOpt, MethodOpt, ModelOpt, OutOpt, PlotOpt, PresetOpt, RtolOpt, SetOpt,
-                     WorkersOpt, check_outputs, chunk_store, echo_written, load_params,
+                     U0Opt, WorkersOpt, check_outputs, chunk_store, echo_written, load_params,
                      preset_label, require_output, resolve_method, save_outputs)
 
 
@@ -34,6 +34,8 @@ def basins_cmd(
     out: OutOpt = None,
     plot: PlotOpt = None,
     orbits_plot: Annotated[Optional[Path], typer.Option("--orbits-plot", help="figure of the coexisting orbits (Fig. 8)")] = None,
+    axes: Annotated[Optional[str], typer.Option("--axes", show_default=False, help="the two state components of the grid, A,B (--x and --v are their ranges; e.g. X,Y for impact_2dof); default: the first two")] = None,
+    u0: U0Opt = None,
 ):
     """Basins of attraction (periodic and chaotic attractors found automatically); a Fig. 7-style
     image and a Fig. 8-style figure of the coexisting attractors."""
@@ -54,7 +56,8 @@ def basins_cmd(
         ds = basins(params, x=x, v=v, grid=grid, method=method, transient=transient,
                     max_periods=max_periods, max_period=max_period, rtol=rtol, atol=atol, section_phase=section_phase,
                     early_stop=not no_early_stop, workers=workers,
-                    progress=bar, store=store, engine=engine)
+                    progress=bar, store=store, engine=engine, axes=axes,
+                    u0=u0)
     from ..plot.basins import plot_basins
     save_outputs(ds, preset, out, plot, plot_basins, store=store)
     if orbits_plot is not None:

@@ -64,7 +64,11 @@ def _omega_text(ds) -> str:
 
 def plot_basins(ds, ax=None, points: bool = True):
     """Basin image over (x0, v0): one discrete colour per attractor, undecided points in grey,
-    a legend with period, contact and basin fraction, the attractors' section points overlaid."""
+    a legend with period, contact and basin fraction, the attractors' section points overlaid
+    (a grid on other components than (X, V), attr ``axes``: the axes named, no overlay)."""
+    axes = str(ds.attrs.get("axes", "X V")).split()
+    planar = axes == ["X", "V"]
+    points = points and planar
     if ax is None:
         fig, ax = new_figure(figsize=(6.4, 5.6))
     else:
@@ -97,8 +101,12 @@ def plot_basins(ds, ax=None, points: bool = True):
                                   label="section points (t = kT)"))
     ax.set_xlim(x0[0] - dx / 2, x0[-1] + dx / 2)
     ax.set_ylim(v0[0] - dv / 2, v0[-1] + dv / 2)
-    ax.set_xlabel(r"initial $X_0$")
-    ax.set_ylabel(r"initial $V_0 = \dot X_0$")
+    if planar:
+        ax.set_xlabel(r"initial $X_0$")
+        ax.set_ylabel(r"initial $V_0 = \dot X_0$")
+    else:
+        ax.set_xlabel(f"initial ${axes[0]}$")
+        ax.set_ylabel(f"initial ${axes[1]}$")
     ax.legend(handles=handles, loc="upper right", fontsize=8, framealpha=0.85)
     title = "basins of attraction" + _omega_text(ds)
     ax.set_title(f"{title}\n{ds.attrs.get('method', '')}: {param_title(ds)}", fontsize=9)

@@ -72,20 +72,11 @@ def state_labels(ds) -> tuple:
     return tuple(m.axis_labels) or tuple(f"${n}$" for n in m.state_names)
 
 
-def check_show(show, names) -> tuple | None:
+def check_show(show, names, field: str = "show") -> tuple | None:
     """``show`` (None, "X,Y" or a pair of component names) as a pair of names among ``names``
-    (the model's ``state_names``); a one-line ParameterError naming ``show`` otherwise."""
-    from ..errors import ParameterError
-    if show is None:
-        return None
-    parts = [t.strip() for t in show.split(",")] if isinstance(show, str) else list(show)
-    if len(parts) != 2:
-        raise ParameterError(f"show: expected two state components (e.g. X,V), got {show!r}")
-    for name in parts:
-        if name not in names:
-            raise ParameterError(f"show: unknown component {name!r} (the model has "
-                                 f"{', '.join(names)})")
-    return tuple(parts)
+    (``simulate.component_pair``)."""
+    from ..simulate import component_pair
+    return component_pair(show, names, field)
 
 
 def shown_components(ds, show, prefix: str = "", suffix: str = ""):

@@ -146,10 +146,13 @@ def basins(params: ParamsBase, *, x=(-3.0, 3.0), v=(-3.0, 3.0), grid=400, method
            atol: float = 1e-10, early_stop: bool = True,
            samples_per_period: int = 200, workers: int | None = None,
            progress=None, lyapunov: bool | None = None, store=None,
-           engine=None, section_phase: float = 0.0) -> xr.Dataset:
+           engine=None, section_phase: float = 0.0, axes=None, u0=None) -> xr.Dataset:
     """Basins of attraction of the stroboscopic map on a grid of initial conditions.
 
-    ``x``, ``v``: (min, max) ranges of the initial X and V (forcing phase 0); ``grid``: points
+    ``x``, ``v``: (min, max) ranges of the initial X and V (forcing phase 0), or of the two
+    state components ``axes`` names (default: the first two; e.g. ("X", "Y") for a model with
+    more; the others start from ``u0``, a mapping {name: value} or n numbers, else 0);
+    ``grid``: points
     per axis (int) or (nx, nv), each >= 2. ``transient``: periods before periodicity is tested
     (capture balls act from the start); ``max_periods``: budget per initial condition;
     ``max_period``: longest period looked for; ``early_stop``: stop a trajectory as soon as it
@@ -180,6 +183,10 @@ def basins(params: ParamsBase, *, x=(-3.0, 3.0), v=(-3.0, 3.0), grid=400, method
     ``store`` / ``engine``: chunked, resumable runs and where they run (``nonsmooth.chunks``):
     each round is a chunk, continued from the attractors the rounds before it found, so the
     rounds run one after the other (on Dask: one worker at a time, with its threads).
+
+    A model with more than X and V: the trajectories start from every component, the
+    attractors are told apart by their section points in (X, V), and no disc or cell is
+    certified (the planar argument needs n = 2): every point runs until its section repeats.
     """
     from ...simulate import check_forced
     check_forced(params, "basins")
@@ -192,6 +199,7 @@ def basins(params: ParamsBase, *, x=(-3.0, 3.0), v=(-3.0, 3.0), grid=400, method
     x_lo, x_hi = _check_range("x", x)
     v_lo, v_hi = _check_range("v", v)
     nx, nv = _check_grid(grid)
+    ia, ib, base = _check_axes(params.model, axes, u0)
     transient = check_int("transient", transient, 0)
     max_periods = check_int("max_periods", max_periods, 1)
     max_period = check_int("max_period", max_period, 1)
@@ -213,13 +221,16 @@ def basins(params: ParamsBase, *, x=(-3.0, 3.0), v=(-3.0, 3.0), grid=400, method
     pk = params.pack()
     scale = max(abs(x_lo), abs(x_hi), abs(v_lo), abs(v_hi), 1.0)
     tol = section_tolerance(rtol, atol, scale)
-    certified = bool(early_stop) and MAP_IS_HOMEOMORPHISM and solver.spec.flow_is_homeomorphism
+    certified = (bool(early_stop) and MAP_IS_HOMEOMORPHISM and solver.spec.flow_is_homeomorphism
+                 and base.size == 0)
     order, first = _order(nx, nv)
     rounds = list(_round_sizes(n, first))
     spec = {"solver": plan_solver(solver, engine), "pk": pk, "x": (x_lo, x_hi),
             "v": (v_lo, v_hi), "nx": nx, "nv": nv, "transient": transient,
             "max_periods": max_periods, "max_period": max_period, "tol": tol,
             "certified": certified, "rounds": rounds}
+    if base.size:  # (only then: stores of plain (X, V) runs stay resumable)
+        spec.update(axes=(ia, ib), base=[float(b) for b in base])
     plan = Plan("basins", {k: v for k, v in spec.items() if k not in ("rounds", "pk")} | {
         "params": dict(zip(params.model.param_names, pk)),
         "early_stop": bool(early_stop), "samples_per_period": spp,
@@ -249,7 +260,11 @@ def basins(params: ParamsBase, *, x=(-3.0, 3.0), v=(-3.0, 3.0), grid=400, method
         for members, state in clouds.groups():
             chaos = _confirm_chaos(solver, pk, state, tol, max_period, scale)
             if chaos is not None:
-                label[members] = found.add(*chaos, kind=KIND_CHAOTIC)
+                first = None
+                if base.size:  # the state at the first cloud point: one period on
+                    first = state.copy()
+                    solver.advance(pk, solver.opts(), first, 1, 0, 1, *output_buffers(1))
+                label[members] = found.add(*chaos, kind=KIND_CHAOTIC, state=first)
         orbits = _sample_orbits(found, solver, pk, spp)
         lyap = None
         if wants_lyapunov(lyapunov, solver):
@@ -287,7 +302,8 @@ def basins(params: ParamsBase, *, x=(-3.0, 3.0), v=(-3.0, 3.0), grid=400, method
                          early_stop=int(bool(early_stop)), section_tol=tol,
                          match_tol=found.match_tol,
                          certification_periods=cert["periods"],
-                         certified_cells=lat.n_certified(), lattice_cells=lat.size()))
+                         certified_cells=lat.n_certified(), lattice_cells=lat.size()),
+                    axes=(ia, ib), base=base)
 
 
 @functools.lru_cache(maxsize=2)
@@ -315,12 +331,14 @@ def _basins_round(spec, i, carry, workers=None, progress=None):
     X0 = np.linspace(x_lo, x_hi, nx)[idx // nv]
     V0 = np.linspace(v_lo, v_hi, nv)[idx % nv]
     pk, certified = spec["pk"], spec["certified"]
+    axes = spec.get("axes", (0, 1))
+    base = np.asarray(spec.get("base", ()), dtype=np.float64)
     with threads(workers), parallel_chunks(8):
         rec, cloud = _run_round_points(solver, pk, X0, V0, a, n, spec["max_periods"],
                                        spec["transient"], spec["tol"], spec["max_period"],
                                        certified, found, lat, _Pace(2 * first),
                                        None if progress is None else
-                                       (lambda d, _t: progress(d - a, b - a)))
+                                       (lambda d, _t: progress(d - a, b - a)), axes, base)
         if certified and not all(found.certified):
             _certify_all(found, solver, pk, cert)
             lat.stale = True
@@ -332,7 +350,8 @@ def _basins_round(spec, i, carry, workers=None, progress=None):
 
 
 def _run_round_points(solver, pk, X0, V0, done_before, n, max_periods, transient, tol,
-                      max_period, certified, found, lat, pace, progress):
+                      max_period, certified, found, lat, pace, progress, axes=(0, 1),
+                      base=np.zeros(0)):
     """Decide the points of one round; returns their records (m, _N_REC): rec[:, _RES] the
     label in discovery numbering (-1 undecided or failed), rec[:, _K] the periods used,
     rec[:, _STATUS] the kernel status; and the undecided trajectories not near a known
@@ -368,7 +387,8 @@ def _run_round_points(solver, pk, X0, V0, done_before, n, max_periods, transient
                 before = int(recs[active, _K].sum())
                 _run_round(solver.code, solver.fns, pk, opts, X0, V0, active, max_periods, transient, tol,
                            max_period, certified, apts, arad2, alab, lat.cells, lat.geo,
-                           budget, states, bufs, recs, cX, cV, cxm, ofs, oi8, ou8)
+                           budget, states, bufs, recs, cX, cV, cxm, ofs, oi8, ou8,
+                           int(axes[0]), int(axes[1]), base)
                 return int(recs[active, _K].sum()) - before
             pace.run(call, active.size, budget * active.size)
             active = active[recs[active, _RES] == _RUNNING]
@@ -380,13 +400,15 @@ def _run_round_points(solver, pk, X0, V0, done_before, n, max_periods, transient
             pts = np.stack([cX[i, :q], cV[i, :q]], axis=1)
             k = found.match(pts)
             if k < 0 and not found.was_rejected(pts):
-                confirmed = _polish(solver, pk, pts, tol)
+                # a model with more than X and V: polish from the trajectory's own state
+                confirmed = _polish(solver, pk, pts, tol, states[i] if base.size else None)
                 if confirmed is None:
                     found.rejected.append(pts)
                 else:
                     k = found.match(confirmed[0])
                     if k < 0:
-                        k = found.add(*confirmed)
+                        k = found.add(confirmed[0], confirmed[1],
+                                      state=confirmed[2] if len(confirmed) > 2 else None)
             if k >= 0:
                 recs[i, _RES] = k
             elif recs[i, _K] < max_periods:
@@ -403,6 +425,22 @@ def _run_round_points(solver, pk, X0, V0, done_before, n, max_periods, transient
     cloud = (done_before + und, bufs[und, 0, :c], bufs[und, 1, :c], states[und])
     recs[recs[:, _RES] == _RES_FAILED, _RES] = LABEL_UNDECIDED
     return recs, cloud
+
+
+def _check_axes(model, axes, u0):
+    """(ia, ib, base) of ``axes`` (two state component names) and ``u0``: base is empty for
+    the plain grid in (X, V) of a two-component model (the compiled path of old), else the
+    full start state u (the axes' values replaced per grid point)."""
+    from ...simulate import component_pair, initial_u
+    names = model.state_names
+    parts = component_pair(axes, names, "axes") or names[:2]
+    ia, ib = (names.index(a) for a in parts)
+    if ia == ib:
+        raise ParameterError(f"axes: two different components are needed, got {axes!r}")
+    u = initial_u(model, 0.0, 0.0, u0)
+    if model.n == 2 and (ia, ib) == (0, 1) and u0 is None:
+        return ia, ib, np.zeros(0)
+    return ia, ib, u
 
 
 def _check_range(name, r):
@@ -430,11 +468,11 @@ def _sample_orbits(found, solver, pk, spp):
     """Each attractor's orbit from its first section point, spp samples per forcing period,
     over its period (a chaotic one: _CHAOS_ORBIT_PERIODS periods)."""
     out = []
-    for pts, kind in zip(found.points, found.kind):
+    for pts, kind, st0 in zip(found.points, found.kind, found.states):
         nout = (len(pts) if kind == KIND_PERIODIC else _CHAOS_ORBIT_PERIODS) * spp
         X, V, R, M, XM, Xm = output_buffers(nout)
-        if solver.advance(pk, solver.opts(), new_state(pts[0, 0], pts[0, 1]), spp, 0, nout,
-                   X, V, R, M, XM, Xm) != 0:
+        s0 = new_state(pts[0, 0], pts[0, 1]) if st0 is None else st0.copy()
+        if solver.advance(pk, solver.opts(), s0, spp, 0, nout, X, V, R, M, XM, Xm) != 0:
             X[:] = np.nan
             V[:] = np.nan
         out.append((np.concatenate([[pts[0, 0]], X]), np.concatenate([[pts[0, 1]], V])))
@@ -450,7 +488,8 @@ def _attractor_lyapunov(found, solver, pk):
     from ..stability import lambda1_points
     if not found.points:
         return np.zeros(0), np.zeros(0)
-    states = np.stack([new_state(pts[0, 0], pts[0, 1]) for pts in found.points])
+    states = np.stack([new_state(pts[0, 0], pts[0, 1]) if st0 is None else st0
+                       for pts, st0 in zip(found.points, found.states)])
     P = np.tile(pk, (len(states), 1))
     lam, err, _ = lambda1_points(P, solver, states, LYAPUNOV_PERIODS)
     return lam, err
@@ -466,7 +505,7 @@ def _label_meanings(key, kind, contact, periods):
 
 
 def _dataset(params, solver, xs, vs, label, used, status, found, key, kind, contact, periods,
-             max_x, orbits, spp, lyap, extra):
+             max_x, orbits, spp, lyap, extra, axes=(0, 1), base=np.zeros(0)):
     n = label.size
     n_att = len(key)
     npt = max([len(found.points[k]) for k in key], default=1)
@@ -558,4 +597,13 @@ def _dataset(params, solver, xs, vs, label, used, status, found, key, kind, cont
             mean_periods_used=float(used.mean()), samples_per_period=spp,
             forcing_period=params.period, **extra),
     )
-    return apply_state_units(ds, params.model)
+    ds = apply_state_units(ds, params.model)
+    if base.size:  # the grid's axes are other components: say which, and the fixed rest
+        m = params.model
+        names = m.state_names
+        units = tuple(m.state_units) + ("1",) * m.n
+        for c, i in (("x0", axes[0]), ("v0", axes[1])):
+            ds[c].attrs.update(long_name=f"initial {names[i]}", units=units[i])
+        ds.attrs["axes"] = f"{names[axes[0]]} {names[axes[1]]}"
+        ds.attrs["u0"] = np.asarray(base, dtype=np.float64)
+    return ds

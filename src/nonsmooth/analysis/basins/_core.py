@@ -42,6 +42,23 @@ def _init_state(state, x0, v0):
 
 
 @nb.njit(cache=True, inline="always")
+def _init_state_axes(state, a, b, ia, ib, base):
+    """A start with every state component from ``base`` (u, n values) but components ``ia``
+    and ``ib`` (the grid's axes) set to a and b; memory slots 0, mode classified."""
+    _init_state(state, base[0], base[1])
+    for i in range(2, base.shape[0]):
+        state[ST_EXTRA + i - 2] = base[i]
+    for i, val in ((ia, a), (ib, b)):
+        if i == 0:
+            state[ST_X] = val
+        elif i == 1:
+            state[ST_V] = val
+            state[ST_VA] = val
+        else:
+            state[ST_EXTRA + i - 2] = val
+
+
+@nb.njit(cache=True, inline="always")
 def _captured(x, v, apts, arad2, alab, cells, cgeo):
     """Label of the certified disc containing (x, v): a certified cell of the lattice
     (cells[i, j] >= 0, geometry cgeo = (x_lo, v_lo, dx, dv)) or an attractor's disc; else -1."""
@@ -62,7 +79,8 @@ def _captured(x, v, apts, arad2, alab, cells, cgeo):
 
 @nb.njit(cache=True)
 def _follow(method, fns, p, opts, x0, v0, max_periods, transient, tol, max_period, early, apts,
-            arad2, alab, cells, cgeo, budget, state, buf, rec, cX, cV, cxm, of, oi8, ou8):
+            arad2, alab, cells, cgeo, budget, state, buf, rec, cX, cV, cxm, of, oi8, ou8, ia, ib,
+            base):
     """Follow one initial condition for at most ``budget`` more periods, resuming where the
     previous call stopped: ``state`` (kernel state), ``buf`` (3, L: the last L section points X,
     V and the largest X of their periods) and ``rec`` (the _N_REC counters) carry everything
@@ -70,7 +88,9 @@ def _follow(method, fns, p, opts, x0, v0, max_periods, transient, tol, max_perio
     rec[_RES] is _RUNNING (budget used up), a captured label >= 0, -1 undecided after
     ``max_periods``, -2 periodic (candidate points in cX[:q], cV[:q] in time order, q in
     rec[_Q], the largest X over its last q periods in cxm[0]) or -3 failed (kernel status in
-    rec[_STATUS]). ``of`` (4, 1), ``oi8``, ``ou8`` (1,) are scratch space."""
+    rec[_STATUS]). ``of`` (4, 1), ``oi8``, ``ou8`` (1,) are scratch space. The grid's axes
+    are state components ``ia``, ``ib`` (0, 1: X, V; the others from ``base``; an empty
+    ``base``: all others 0)."""
     k = rec[_K]
     if k == 0:
         if early:
@@ -78,7 +98,10 @@ def _follow(method, fns, p, opts, x0, v0, max_periods, transient, tol, max_perio
             if lab >= 0:
                 rec[_RES] = lab
                 return
-        _init_state(state, x0, v0)
+        if base.shape[0] == 0:
+            _init_state(state, x0, v0)
+        else:
+            _init_state_axes(state, x0, v0, ia, ib, base)
     L = buf.shape[1]
     bx = buf[0]
     bv = buf[1]
@@ -143,14 +166,14 @@ def _follow(method, fns, p, opts, x0, v0, max_periods, transient, tol, max_perio
 @nb.njit(cache=True, parallel=True)
 def _run_round(method, fns, p, opts, X0, V0, active, max_periods, transient, tol, max_period, early,
                apts, arad2, alab, cells, cgeo, budget, states, bufs, recs, cX, cV, cxm, ofs,
-               oi8, ou8):
+               oi8, ou8, ia, ib, base):
     """One slice of a round: every point ``active[j]`` followed for at most ``budget`` more
     periods (``_follow``; per-point arrays indexed by the point)."""
     for j in nb.prange(active.shape[0]):
         i = active[j]
         _follow(method, fns, p, opts, X0[i], V0[i], max_periods, transient, tol, max_period, early,
                 apts, arad2, alab, cells, cgeo, budget, states[i], bufs[i], recs[i], cX[i],
-                cV[i], cxm[i:i + 1], ofs[i], oi8[i], ou8[i])
+                cV[i], cxm[i:i + 1], ofs[i], oi8[i], ou8[i], ia, ib, base)
 
 
 @nb.njit(cache=True, inline="always")

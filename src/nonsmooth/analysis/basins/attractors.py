@@ -51,6 +51,7 @@ class _Attractors:
         self.radius = []   # (q,) capture radii
         self.certified = []
         self.kind = []
+        self.states = []  # kernel state at the first section point (None: from X, V alone)
         self.rejected = []  # (q, 2) arrays
 
     def flat(self):
@@ -73,9 +74,11 @@ class _Attractors:
     def was_rejected(self, pts):
         return any(_same_orbit(pts, a, self.match_tol) for a in self.rejected)
 
-    def add(self, pts, extremes, kind=KIND_PERIODIC):
+    def add(self, pts, extremes, kind=KIND_PERIODIC, state=None):
         """A new attractor with section points ``pts`` and ``extremes`` = (max X, min X,
-        visited-mode mask) over the periods followed; returns its label."""
+        visited-mode mask) over the periods followed (and the kernel ``state`` at its first
+        section point, for a model with more than X and V); returns its label."""
+        self.states.append(None if state is None else np.array(state, dtype=np.float64))
         self.points.append(np.array(pts, dtype=np.float64))
         self.max_x.append(float(extremes[0]))
         self.min_x.append(float(extremes[1]))
@@ -162,7 +165,7 @@ class _Clouds:
         return out
 
 
-def _polish(solver, pk, pts, tol):
+def _polish(solver, pk, pts, tol, state=None):
     """A candidate attractor's section points, refined and confirmed; None if it is not a
     periodic attractor.
 
@@ -174,9 +177,14 @@ def _polish(solver, pk, pts, tol):
     q before them within tol) and stays on its points within tol for a further window of at
     least _CONFIRM_MIN periods (and _CONFIRM_MULT of its periods): a chaotic trajectory that
     shadowed an unstable periodic orbit long enough to pass the test drifts away. Returns
-    (points, (max X, min X, visited-mode mask))."""
+    (points, (max X, min X, visited-mode mask)).
+
+    ``state``: the trajectory's kernel state at its last candidate point (a model with more
+    than X and V: the other components are not in ``pts``); the orbit is followed from it,
+    and a third item is returned, the kernel state at the first returned point."""
     q = len(pts)
-    state = new_state(pts[-1, 0], pts[-1, 1])
+    full = state is not None
+    state = state.copy() if full else new_state(pts[-1, 0], pts[-1, 1])
     X, V, R, M, XM, Xm = output_buffers(q)
     opts = solver.opts()
     last = pts[-1].copy()
@@ -201,6 +209,9 @@ def _polish(solver, pk, pts, tol):
             return None
         if not ((np.abs(X - W[0]) <= tol).all() and (np.abs(V - W[1]) <= tol).all()):
             return None
+    if full:  # the state is at the last point X[q-1] = X[d-1]: rotate it first
+        pts_d = np.roll(out[0], 1, axis=0)
+        return pts_d, out[1], state
     return out
 
 
