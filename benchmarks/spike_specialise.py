@@ -42,7 +42,7 @@ from nonsmooth.errors import ParameterError
 _HERE = Path(nonsmooth.__file__).resolve().parent / "integrate"
 #: Helpers of ``hybrid`` that receive a model function: inlined at numba's IR level.
 _INLINE = ("_rk_step", "_mode_class", "_saltation", "_curved_rate", "_curved_at",
-           "_immediate_exit_curved", "_curved_scan", "_curved_exit")
+           "_immediate_exit_curved", "_g_eval", "_guard_scan", "_guard_exit")
 _PARTS = ("field", "jacobian", "guards", "transition", "initial", "linear")
 
 

@@ -22,6 +22,9 @@ DirectionOpt = Annotated[str, typer.Option(
     "--direction", help="crossings counted: decreasing (the surface's expression goes from "
                         "positive to negative), increasing or both")]
 
+MaxTimeOpt = Annotated[float, typer.Option(
+    "--max-time", help="time allowed to reach the next crossing")]
+
 
 def _method(params, method):
     if method is None and "exact" in params.model.methods:
@@ -42,8 +45,7 @@ def limit_cycle_cmd(
     transient: Annotated[int, typer.Option(
         "--transient", help="crossings of the section before Newton starts (>= 1)")] = 20,
     tol: Annotated[float, typer.Option("--tol", help="Newton tolerance")] = 1e-10,
-    max_time: Annotated[float, typer.Option(
-        "--max-time", help="time allowed to reach the next crossing")] = 1e4,
+    max_time: MaxTimeOpt = 1e4,
     method: OrbitMethodOpt = None,
     rtol: RtolOpt = 1e-10,
     atol: AtolOpt = 1e-12,
@@ -156,8 +158,7 @@ def surface_bifurcation_cmd(
         "--transient", help="crossings skipped at each value")] = 100,
     crossings: Annotated[int, typer.Option(
         "--crossings", help="crossings recorded at each value")] = 50,
-    max_time: Annotated[float, typer.Option(
-        "--max-time", help="time allowed to reach the next crossing")] = 1e4,
+    max_time: MaxTimeOpt = 1e4,
     method: OrbitMethodOpt = None,
     rtol: RtolOpt = 1e-10,
     atol: AtolOpt = 1e-12,

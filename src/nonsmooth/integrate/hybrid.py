@@ -20,7 +20,7 @@ Design summary
   once; more than ``ZENO_MAX`` consecutive transitions each < ``ZENO_DT`` T apart -> ZENO.
 * A curved guard (a row marked by NaN in its constant column, ``models.curved_row``) is
   evaluated with its gradient by the model's ``curved`` function on the same interpolant
-  (``_curved_exit``): ends that clear zero by twice the Hermite slope bound pass at once;
+  (``_guard_exit``): ends that clear zero by twice the Hermite slope bound pass at once;
   otherwise the step is halved left to right until each piece's Hermite of (g, g'), less an
   error bound estimated from the true g at its midpoint, clears zero, so grazing dips are
   found; the crossing is located by Illinois on the true g. Its gradient enters the saltation
@@ -88,10 +88,11 @@ from .contract import (  # noqa: E402
 )
 from .pwlinear import (BD_D2, BD_D3, BD_D4, BD_R, EXCLUDED, HERM_ERR, MC_A,  # noqa: E402
                        MC_K, MC_LMAX, N_BD, N_MC, accel, apply_propagator, classify,
-                       energy_norm, eval_state, functional_bounds, herm_coeffs, hom_part, jerk,
-                       mode_coeffs, propagator)
-from .linmodes import (N_TAYLOR, THETA_POLY, guard_poly, lin_matrix, poly_component,  # noqa: E402
-                       poly_exit, poly_state, poly_tangent, poly_x_extrema, taylor_terms)
+                       energy_norm, eval_state, functional_bounds, herm_clear, herm_coeffs,
+                       hom_part, jerk, mode_coeffs, propagator)
+from .linmodes import (N_TAYLOR, POLY_DEPTH, THETA_POLY, guard_poly, lin_matrix,  # noqa: E402
+                       poly_component, poly_m4, poly_state, poly_tangent, poly_x_extrema, pval,
+                       taylor_terms)
 from .record import record_interval  # noqa: E402
 from .roots import illinois_point, illinois_update, quad_roots01  # noqa: E402
 from .rkstep import (_A, _B, _C, _E, _FM, _NS, _control, _cubic, _shrink,  # noqa: E402
@@ -292,20 +293,6 @@ def _g_dd(cf, G, k, n, u, f, C, S, om, MC, mode, F, cdd, hs):
     return dd - om * om * (G[k, n + 1] * C + G[k, n + 2] * S)
 
 
-@nb.njit(cache=True, inline="always", fastmath=_FM)
-def _herm_clear(g0, d0, g1, d1, L, M4):
-    """True when g >= 0 on [0, L] is certified from its ends alone: the cubic Hermite H of
-    (g, g') less its pointwise error bound M4 L^4 u^2 (1 - u)^2 / 24 (u = s / L, M4 >= |g''''|)
-    is a quartic in u whose Bernstein coefficients are all >= 0."""
-    b1, b2, b3 = herm_coeffs(g0, d0, g1, d1, L)
-    c = M4 * (L * L) * (L * L) / 24.0
-    a2 = b2 - c
-    a3 = b3 + 2.0 * c
-    return (g0 >= 0.0 and g1 >= 0.0 and g0 + 0.25 * b1 >= 0.0
-            and g0 + 0.5 * b1 + a2 / 6.0 >= 0.0
-            and g0 + 0.75 * b1 + 0.5 * a2 + 0.25 * a3 >= 0.0)
-
-
 @nb.njit(cache=True)
 def _first_negative(cf, s_end, ga, da, dda, gb, db, ddb, G, k, n, q0, q1, q2, q3, C, S, om, hs,
                     MC, mode, y0, z0, F, M2, M3, M4, stack):
@@ -328,7 +315,7 @@ def _first_negative(cf, s_end, ga, da, dda, gb, db, ddb, G, k, n, q0, q1, q2, q3
         if gb < 0.0:
             return b, gb
         L = (b - a) * hs
-        if not _herm_clear(ga, da, gb, db, L, M4) and classify(
+        if not herm_clear(ga, da, gb, db, L, M4) and classify(
                 -ga, -da, -dda, -gb, -db, L, M2, M3, M4) != EXCLUDED:
             if depth < SCAN_DEPTH:
                 stack[top, 0] = b
@@ -502,19 +489,33 @@ def _immediate_exit_curved(curved, mode, tau, G, ng, n, u, f0, C, S, om, pp, mem
 
 
 @nb.njit(cache=True)
-def _curved_scan(curved, mode, k, tau, C, S, hs, om, n, u, f0, u1, f1, pp, mem, gr, us, stack,
-                 end, s_best, pm, TW):
+def _g_eval(kind, s, cp, curved, mode, k, tau, C, S, hs, om, n, u, f0, u1, f1, pp, mem, gr, us,
+            pm, TW):
+    """(g, dg/dt) of guard k at the fraction s of the step: kind 0, an affine guard on a
+    series piece (``cp``: its polynomial in time, ``linmodes.guard_poly``); kind 1, a curved
+    guard (``_curved_at``)."""
+    if kind == 0:
+        return pval(cp, s * hs)
+    return _curved_at(curved, mode, k, tau, C, S, hs, om, n, u, f0, u1, f1, pp, mem, gr, us, s,
+                      pm, TW)
+
+
+@nb.njit(cache=True)
+def _guard_scan(kind, cp, curved, mode, k, tau, C, S, hs, om, n, u, f0, u1, f1, pp, mem, gr,
+                us, stack, end, s_best, pm, TW):
     """The first piece of [0, end] (fractions of the step, left to right) that holds a
-    negative value of curved guard k: (a, b, g(b)) with g(a) >= 0 > g(b), or (-1, -1, 0).
-    A piece passes when the cubic Hermite of (g, g') at its ends, less four times the quartic
-    error bound estimated from the true g at its midpoint, stays >= 0 (``_herm_clear``); else
-    it is halved (at most CURVED_DEPTH times); on a piece whose end is negative the Hermite's
-    interior minima are tried first."""
-    ga, da = _curved_at(curved, mode, k, tau, C, S, hs, om, n, u, f0, u1, f1, pp, mem, gr, us,
-                        0.0, pm, TW)
+    negative value of guard k (``_g_eval``): (a, b, g(b)) with g(a) >= 0 > g(b), or
+    (-1, -1, 0). A piece passes when the cubic Hermite of (g, g') at its ends, less its error
+    bound, stays >= 0 (``herm_clear``): the bound of g'''' is the polynomial's own (kind 0,
+    rigorous) or four times the one the true g at the piece's midpoint implies (kind 1).
+    Else the piece is halved (at most POLY_DEPTH / CURVED_DEPTH times); on a piece whose end
+    is negative the Hermite's interior minima are tried first."""
+    ga, da = _g_eval(kind, 0.0, cp, curved, mode, k, tau, C, S, hs, om, n, u, f0, u1, f1, pp,
+                     mem, gr, us, pm, TW)
     ga = max(ga, 0.0)  # round-off after the switch into this mode
-    gb, db = _curved_at(curved, mode, k, tau, C, S, hs, om, n, u, f0, u1, f1, pp, mem, gr, us,
-                        end, pm, TW)
+    gb, db = _g_eval(kind, end, cp, curved, mode, k, tau, C, S, hs, om, n, u, f0, u1, f1, pp,
+                     mem, gr, us, pm, TW)
+    max_depth = POLY_DEPTH if kind == 0 else CURVED_DEPTH
     a = 0.0
     b = end
     depth = 0
@@ -529,19 +530,22 @@ def _curved_scan(curved, mode, k, tau, C, S, hs, om, n, u, f0, u1, f1, pp, mem, 
             for q in (min(r1, r2), max(r1, r2)):
                 if 0.0 < q < 1.0 and 2.0 * b2 + 6.0 * b3 * q > 0.0:  # a minimum
                     sq = a + q * (b - a)
-                    gq, _ = _curved_at(curved, mode, k, tau, C, S, hs, om, n, u, f0, u1, f1,
-                                       pp, mem, gr, us, sq, pm, TW)
+                    gq, _ = _g_eval(kind, sq, cp, curved, mode, k, tau, C, S, hs, om, n, u, f0,
+                                    u1, f1, pp, mem, gr, us, pm, TW)
                     if gq < 0.0:
                         return a, sq, gq
             return a, b, gb
         m = 0.5 * (a + b)
-        gm, dm = _curved_at(curved, mode, k, tau, C, S, hs, om, n, u, f0, u1, f1, pp, mem, gr,
-                            us, m, pm, TW)
-        b1, b2, b3 = herm_coeffs(ga, da, gb, db, L)
-        e = abs(gm - (ga + 0.5 * b1 + 0.25 * b2 + 0.125 * b3))
-        M4 = 4.0 * 384.0 * e / ((L * L) * (L * L)) if L > 0.0 else 0.0
-        if not _herm_clear(ga, da, gb, db, L, M4):
-            if depth < CURVED_DEPTH:
+        gm, dm = _g_eval(kind, m, cp, curved, mode, k, tau, C, S, hs, om, n, u, f0, u1, f1, pp,
+                         mem, gr, us, pm, TW)
+        if kind == 0:
+            M4 = poly_m4(cp, b * hs)
+        else:
+            b1, b2, b3 = herm_coeffs(ga, da, gb, db, L)
+            e = abs(gm - (ga + 0.5 * b1 + 0.25 * b2 + 0.125 * b3))
+            M4 = 4.0 * 384.0 * e / ((L * L) * (L * L)) if L > 0.0 else 0.0
+        if not herm_clear(ga, da, gb, db, L, M4):
+            if depth < max_depth:
                 stack[top, 0] = b
                 stack[top, 1] = gb
                 stack[top, 2] = db
@@ -567,46 +571,53 @@ def _curved_scan(curved, mode, k, tau, C, S, hs, om, n, u, f0, u1, f1, pp, mem, 
 
 
 @nb.njit(cache=True)
-def _curved_exit(curved, mode, k, tau, C, S, hs, om, n, u, f0, u1, f1, pp, mem, gr, us, stack,
-                 s_best, pm, TW):
-    """Exit test of curved guard k over the step just taken: (lo, hi) bracketing its first
-    crossing to S_TOL of the step (g(lo) >= 0 > g(hi)), (2.0, 2.0) when it stays >= 0 up to
-    ``s_best`` (an earlier crossing of another guard), (-1.0, -1.0) when location fails.
+def _guard_exit(kind, cp, curved, mode, k, tau, C, S, hs, om, n, u, f0, u1, f1, pp, mem, gr,
+                us, stack, s_best, pm, TW):
+    """Exit test of guard k (``_g_eval``: an affine guard on a series piece, or a curved
+    guard) over the step just taken: (lo, hi) bracketing its first crossing to S_TOL of the
+    step (fractions, g(lo) >= 0 > g(hi)), (2.0, 2.0) when it stays >= 0 up to ``s_best`` (an
+    earlier crossing of another guard), (-1.0, -1.0) when location fails.
 
-    A step whose ends clear zero by twice the Hermite slope bound is passed at once. Otherwise
-    the first negative piece (``_curved_scan``) is bracketed, the crossing located by
-    Illinois on the true g, and [0, lo] scanned again, so that a dip and a return before it
-    are found too (the first crossing, grazing dips included)."""
-    g0, d0 = _curved_rate(curved, mode, k, tau, C, S, n, u, f0, pp, mem, gr)
+    A step whose ends clear zero is passed at once (kind 0: the Hermite less the polynomial's
+    bound of g''''; kind 1: by twice the Hermite slope bound). Otherwise the first negative
+    piece (``_guard_scan``) is bracketed, the crossing located by Illinois on the true g, and
+    [0, lo] scanned again, so that a dip and a return before it are found too (the first
+    crossing, grazing dips included; ``_first_crossing`` does this for the other guards)."""
+    g0, d0 = _g_eval(kind, 0.0, cp, curved, mode, k, tau, C, S, hs, om, n, u, f0, u1, f1, pp,
+                     mem, gr, us, pm, TW)
     g0 = max(g0, 0.0)  # round-off after the switch into this mode
-    g1, d1 = _curved_at(curved, mode, k, tau, C, S, hs, om, n, u, f0, u1, f1, pp, mem, gr, us,
-                        1.0, pm, TW)
-    sl = hs * (abs(d0) + abs(d1))
-    if g1 >= 0.0 and min(g0, g1) - 2.0 * _HERM_SLOPE * sl > 1e-9 * (abs(g0) + abs(g1) + sl):
-        return 2.0, 2.0
-    lo, hi, ghi = _curved_scan(curved, mode, k, tau, C, S, hs, om, n, u, f0, u1, f1, pp, mem,
-                               gr, us, stack, 1.0, s_best, pm, TW)
+    g1, d1 = _g_eval(kind, 1.0, cp, curved, mode, k, tau, C, S, hs, om, n, u, f0, u1, f1, pp,
+                     mem, gr, us, pm, TW)
+    if kind == 0:
+        if herm_clear(g0, d0, g1, d1, hs, poly_m4(cp, hs)):
+            return 2.0, 2.0
+    else:
+        sl = hs * (abs(d0) + abs(d1))
+        if g1 >= 0.0 and min(g0, g1) - 2.0 * _HERM_SLOPE * sl > 1e-9 * (abs(g0) + abs(g1) + sl):
+            return 2.0, 2.0
+    lo, hi, ghi = _guard_scan(kind, cp, curved, mode, k, tau, C, S, hs, om, n, u, f0, u1, f1,
+                              pp, mem, gr, us, stack, 1.0, s_best, pm, TW)
     if hi < 0.0:
         return 2.0, 2.0
     for _ in range(8):
         if lo >= s_best:
             return 2.0, 2.0
-        glo = _curved_at(curved, mode, k, tau, C, S, hs, om, n, u, f0, u1, f1, pp, mem, gr,
-                         us, lo, pm, TW)[0] if lo > 0.0 else g0
+        glo = _g_eval(kind, lo, cp, curved, mode, k, tau, C, S, hs, om, n, u, f0, u1, f1, pp,
+                      mem, gr, us, pm, TW)[0] if lo > 0.0 else g0
         side = 0
         for _ in range(200):
             if hi - lo <= S_TOL:
                 break
             sm = illinois_point(lo, hi, glo, ghi)
-            gm = _curved_at(curved, mode, k, tau, C, S, hs, om, n, u, f0, u1, f1, pp, mem, gr,
-                            us, sm, pm, TW)[0]
+            gm = _g_eval(kind, sm, cp, curved, mode, k, tau, C, S, hs, om, n, u, f0, u1, f1, pp,
+                         mem, gr, us, pm, TW)[0]
             lo, hi, glo, ghi, side = illinois_update(lo, hi, glo, ghi, side, sm, gm)
         if hi - lo > S_TOL:
             return -1.0, -1.0
         if not lo > 0.0:
             break
-        a2, b2, g2 = _curved_scan(curved, mode, k, tau, C, S, hs, om, n, u, f0, u1, f1, pp, mem,
-                                  gr, us, stack, lo, lo, pm, TW)
+        a2, b2, g2 = _guard_scan(kind, cp, curved, mode, k, tau, C, S, hs, om, n, u, f0, u1, f1,
+                                 pp, mem, gr, us, stack, lo, lo, pm, TW)
         if b2 < 0.0:
             break
         lo, hi, ghi = a2, b2, g2
@@ -621,6 +632,15 @@ def _n_curved(G, ng, n):
         if math.isnan(G[k, n]):
             c += 1
     return c
+
+
+@nb.njit(cache=True, inline="always")
+def _finite(u, n):
+    """Every one of u[0:n] is finite."""
+    for i in range(n):
+        if not math.isfinite(u[i]):
+            return False
+    return True
 
 
 @nb.njit(cache=True, inline="always")
@@ -1043,9 +1063,8 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
         mem[i] = state[ST_EXTRA + n - 2 + i]
     mode = int(state[ST_MODE])
     h = state[ST_H]
-    for i in range(n):
-        if not math.isfinite(u[i]):
-            return st.NON_FINITE
+    if not _finite(u, n):
+        return st.NON_FINITE
 
     T = 2.0 * math.pi / om
     dt = T / per_period
@@ -1154,11 +1173,7 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
                     taylor_terms(MX[mode], n, u, C, S, TW)
                     poly_state(TW, n, hs, u1)
                     C1, S1 = _rotate(C, S, om * hs)
-                    ok = True
-                    for i in range(n):
-                        if not math.isfinite(u1[i]):
-                            ok = False
-                    if not ok:
+                    if not _finite(u1, n):
                         code = st.NON_FINITE
                         break
                     field(mode, tau + hs, C1, S1, u1, pp, mem, f1)
@@ -1181,20 +1196,13 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
                 s_lo = 0.0  # the located crossing lies in [s_lo, s_best] (fractions)
                 En = -1.0  # energy norm of a closed-form piece, when needed
                 for k in range(ng):
-                    if pm and not (ncv > 0 and math.isnan(G[k, n])):
-                        guard_poly(G, k, n, TW, cp)
-                        lo, hi = poly_exit(cp, hs, s_best * hs, stack, S_TOL * hs)
-                        if hi < 0.0:
-                            code = st.EVENT_FAILED
-                            break
-                        if hi < s_best * hs:
-                            s_best = hi / hs
-                            s_lo = lo / hs
-                            k_tr = k
-                        continue
-                    if ncv > 0 and math.isnan(G[k, n]):
-                        lo, hi = _curved_exit(curved, mode, k, tau, C, S, hs, om, n, u, f0, u1,
-                                              f1, pp, mem, gr, us, stack, s_best, pm, TW)
+                    curv = ncv > 0 and math.isnan(G[k, n])
+                    if pm or curv:  # a series piece's polynomial guard, or a curved one
+                        if not curv:
+                            guard_poly(G, k, n, TW, cp)
+                        lo, hi = _guard_exit(1 if curv else 0, cp, curved, mode, k, tau, C, S,
+                                             hs, om, n, u, f0, u1, f1, pp, mem, gr, us, stack,
+                                             s_best, pm, TW)
                         if hi < 0.0:
                             code = st.EVENT_FAILED
                             break
@@ -1263,7 +1271,7 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
                             M4 = _guard_bounds(cf, G, k, n, q2, q3, om, hs, MC, mode, y0, z0,
                                                BD)[2]
                         if not (hm > HERM_ERR * M4 * ((hs * hs) * (hs * hs))
-                                or _herm_clear(g0, d0, g1, d1, hs, M4)):
+                                or herm_clear(g0, d0, g1, d1, hs, M4)):
                             hi, ghi = _scan_step(cf, g0, d0, g1, d1, u, f0, u1, f1, C, S, C1, S1,
                                                  G, k, n, q0, q1, q2, q3, om, hs, MC, mode, y0,
                                                  z0, MF[mode], stack, BD)
@@ -1444,11 +1452,7 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
                                           ua, ma, n_tiny > 0, tw_last):
                     code = st.GRAZING
                     break
-                ok = True
-                for i in range(n):
-                    if not math.isfinite(u[i]):
-                        ok = False
-                if not ok:
+                if not _finite(u, n):
                     code = st.NON_FINITE
                     break
                 xmax = max(xmax, u[0])

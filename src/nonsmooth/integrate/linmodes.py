@@ -13,7 +13,8 @@ A (singular or not, resonant or not). On a piece of length L with rho L <= THETA
 w_j = M^j z0 / j!, and N_TAYLOR = 28 terms leave a remainder below 2^29 / 29! ~ 6e-23 of
 the scale of the state. The state is then a polynomial in s known to round-off, and so is
 every affine guard: g(s) = sum_j (G_k . w_j) s^j (a guard row is a row over z). Its derivative
-bounds follow from the coefficients, so the exit test is certified (``poly_first_negative``).
+bounds follow from the coefficients (``poly_m4``), so the exit test is certified
+(``hybrid._guard_exit``).
 
 A model declares such a mode through ``linear(mode, p, out) -> 2`` with ``out[0:n*n]`` = A
 (row-major), then b, f_c, f_s (n each); see ``models.base``.
@@ -26,8 +27,7 @@ import math
 import numba as nb
 import numpy as np
 
-from .pwlinear import herm_coeffs
-from .roots import illinois_point, illinois_update, quad_roots01
+from .roots import illinois_point, illinois_update
 
 THETA_POLY = 2.0  # rho L on a full piece
 N_TAYLOR = 28  # terms beyond the constant one
@@ -131,7 +131,7 @@ def guard_poly(G, k, n, TW, c):
 
 
 @nb.njit(cache=True, inline="always")
-def _pval(c, s):
+def pval(c, s):
     """(p(s), p'(s)) of the polynomial c."""
     v = c[N_TAYLOR]
     d = N_TAYLOR * c[N_TAYLOR]
@@ -142,119 +142,13 @@ def _pval(c, s):
 
 
 @nb.njit(cache=True, inline="always")
-def _m4(c, b):
+def poly_m4(c, b):
     """Bound of |p''''| on [0, b] from the coefficients (plus the series' remainder, far
     below round-off on a piece)."""
     acc = 0.0
     for j in range(N_TAYLOR, 3, -1):  # Horner in b
         acc = acc * b + abs(c[j]) * (j * (j - 1) * (j - 2) * (j - 3))
     return acc
-
-
-@nb.njit(cache=True)
-def _clear(ga, da, gb, db, L, M4):
-    """g >= 0 on the piece is certified: the cubic Hermite of (g, g') less its pointwise
-    error bound has nonnegative Bernstein coefficients (as ``hybrid._herm_clear``)."""
-    b1, b2, b3 = herm_coeffs(ga, da, gb, db, L)
-    e = M4 * (L * L) * (L * L) / 24.0
-    a2 = b2 - e
-    a3 = b3 + 2.0 * e
-    return (ga >= 0.0 and gb >= 0.0 and ga + 0.25 * b1 >= 0.0
-            and ga + 0.5 * b1 + a2 / 6.0 >= 0.0
-            and ga + 0.75 * b1 + 0.5 * a2 + 0.25 * a3 >= 0.0)
-
-
-@nb.njit(cache=True)
-def _poly_scan(c, end, s_best, stack):
-    """The first piece of [0, end] (left to right) that holds a negative value of the
-    polynomial ``c``: (a, b, g(b)) with g(a) >= 0 > g(b), or (-1, -1, 0) when g >= 0 is
-    certified up to min(end, s_best). A piece passes when its Hermite of (g, g') less the
-    coefficients' bound of the fourth derivative clears zero; else it is halved (at most
-    POLY_DEPTH times); on a piece whose end is negative the Hermite's interior minima are
-    tried first."""
-    ga, da = _pval(c, 0.0)
-    ga = max(ga, 0.0)  # round-off after the switch into this mode
-    gb, db = _pval(c, end)
-    M4 = _m4(c, end)
-    a = 0.0
-    b = end
-    depth = 0
-    top = 0
-    while True:
-        if a >= s_best:
-            return -1.0, -1.0, 0.0
-        w = b - a
-        if gb < 0.0:
-            b1, b2, b3 = herm_coeffs(ga, da, gb, db, w)
-            r1, r2 = quad_roots01(b1, 2.0 * b2, 3.0 * b3)
-            for q in (min(r1, r2), max(r1, r2)):
-                if 0.0 < q < 1.0 and 2.0 * b2 + 6.0 * b3 * q > 0.0:
-                    gq, _ = _pval(c, a + q * w)
-                    if gq < 0.0:
-                        return a, a + q * w, gq
-            return a, b, gb
-        if not _clear(ga, da, gb, db, w, M4 if depth == 0 else _m4(c, b)):
-            if depth < POLY_DEPTH:
-                stack[top, 0] = b
-                stack[top, 1] = gb
-                stack[top, 2] = db
-                stack[top, 4] = depth + 1
-                top += 1
-                b = 0.5 * (a + b)
-                gb, db = _pval(c, b)
-                depth += 1
-                continue
-            gm, _ = _pval(c, 0.5 * (a + b))
-            if gm < 0.0:
-                return a, 0.5 * (a + b), gm
-        if top == 0:
-            return -1.0, -1.0, 0.0
-        top -= 1
-        a = b
-        ga = gb
-        da = db
-        b = stack[top, 0]
-        gb = stack[top, 1]
-        db = stack[top, 2]
-        depth = int(stack[top, 4])
-
-
-@nb.njit(cache=True)
-def poly_exit(c, L, s_best, stack, tol):
-    """Exit test of a guard that is the polynomial ``c`` in s on a piece [0, L]: (lo, hi)
-    bracketing its first crossing to ``tol`` (times, g(lo) >= 0 > g(hi)), (2L, 2L) when it
-    stays >= 0 up to ``s_best`` (a time: an earlier crossing of another guard), (-1, -1)
-    when location fails. The first negative piece (``_poly_scan``) is bracketed and the
-    crossing located by Illinois; then [0, lo] is scanned again, so that a dip and a return
-    before it are found too (the first crossing, as ``hybrid._first_crossing`` ensures for
-    affine guards)."""
-    ga, da = _pval(c, 0.0)
-    gb, db = _pval(c, L)
-    if _clear(max(ga, 0.0), da, gb, db, L, _m4(c, L)):
-        return 2.0 * L, 2.0 * L
-    lo, hi, ghi = _poly_scan(c, L, s_best, stack)
-    if hi < 0.0:
-        return 2.0 * L, 2.0 * L
-    for _ in range(8):
-        if lo >= s_best:
-            return 2.0 * L, 2.0 * L
-        glo = _pval(c, lo)[0] if lo > 0.0 else max(ga, 0.0)
-        side = 0
-        for _ in range(200):
-            if hi - lo <= tol:
-                break
-            sm = illinois_point(lo, hi, glo, ghi)
-            gm = _pval(c, sm)[0]
-            lo, hi, glo, ghi, side = illinois_update(lo, hi, glo, ghi, side, sm, gm)
-        if hi - lo > tol:
-            return -1.0, -1.0
-        if not lo > 0.0:
-            break
-        a2, b2, g2 = _poly_scan(c, lo, lo, stack)  # an earlier crossing inside [0, lo]?
-        if b2 < 0.0:
-            break
-        lo, hi, ghi = a2, b2, g2
-    return lo, hi
 
 
 @nb.njit(cache=True)

@@ -264,6 +264,20 @@ def herm_coeffs(g0, d0, g1, d1, L):
     return a1, a2, a3
 
 
+@nb.njit(cache=True, inline="always", fastmath={"contract", "reassoc"})
+def herm_clear(g0, d0, g1, d1, L, M4):
+    """True when g >= 0 on [0, L] is certified from its ends alone: the cubic Hermite H of
+    (g, g') less its pointwise error bound M4 L^4 u^2 (1 - u)^2 / 24 (u = s / L, M4 >= |g''''|)
+    is a quartic in u whose Bernstein coefficients are all >= 0."""
+    b1, b2, b3 = herm_coeffs(g0, d0, g1, d1, L)
+    c = M4 * (L * L) * (L * L) / 24.0
+    a2 = b2 - c
+    a3 = b3 + 2.0 * c
+    return (g0 >= 0.0 and g1 >= 0.0 and g0 + 0.25 * b1 >= 0.0
+            and g0 + 0.5 * b1 + a2 / 6.0 >= 0.0
+            and g0 + 0.75 * b1 + 0.5 * a2 + 0.25 * a3 >= 0.0)
+
+
 @nb.njit(cache=True, inline="always")
 def herm_max(g0, d0, g1, d1, L):
     """Max over [0, L] of the cubic Hermite interpolant of (g, g') and its argmax s."""
