@@ -356,3 +356,69 @@ def test_surface_bifurcation_diagram_follows_the_stick_slip_cycle(tmp_path, caps
                             "--transient", "20", "--plot", str(fig)], capsys)
     assert code == 0 and "4 cycles (1 crossing(s) per turn: 4)" in out
     assert fig.stat().st_size > 0
+
+
+FOLD_MODEL = """import nonsmooth as ns
+MODEL = ns.model_from_equations(
+    "fold_of_cycles", states=("X", "Y"), parameters={"mu": -0.5},
+    modes={"flow": ["X*(mu + 2*(X**2 + Y**2) - (X**2 + Y**2)**2) - Y",
+                    "Y*(mu + 2*(X**2 + Y**2) - (X**2 + Y**2)**2) + X"]}, omega=None)
+"""
+
+
+def test_limit_cycles_continued_through_their_fold_against_the_closed_form(tmp_path, capsys):
+    """r' = r (mu + 2 r^2 - r^4), theta' = 1: cycles where mu = s^2 - 2 s (s = r^2), the outer
+    one stable, the inner one unstable, meeting in a fold at mu = -1, r = 1; every period 2 pi,
+    the multiplier exp(2 pi 4 s (1 - s)). Pseudo-arclength continuation of the cycles on
+    Y = 0 (increasing) goes round the fold from the stable onto the unstable branch and
+    locates it; a cycle started on the section is no immediate crossing of it."""
+    f = tmp_path / "fold.py"
+    f.write_text(FOLD_MODEL)
+    ns_ = {}
+    exec(FOLD_MODEL, ns_)
+    p = ns_["MODEL"].params()
+    lc = ns.limit_cycle(p, ("Y", "increasing"), x0=1.5)
+    assert lc.attrs["status"] == "converged"
+    assert float(lc.period) == pytest.approx(2 * math.pi, abs=1e-9)  # (was 2e-19: the start)
+    s0 = 1 + math.sqrt(0.5)
+    assert float(lc.X_section) == pytest.approx(math.sqrt(s0), abs=1e-9)
+    br = ns.continuation(p, "mu", section=("Y", "increasing"), x0=1.5, direction="down",
+                         step=0.05, bounds=(-1.5, -0.05))
+    assert br.attrs["status"] == "left the bounds" and br.attrs["section"] == "Y = 0, increasing"
+    mu, X = br.mu.values, br.X_section.values[:, 0]
+    s = X**2
+    assert np.allclose(mu, s**2 - 2 * s, atol=1e-9, rtol=0)
+    assert np.allclose(br.period.values, 2 * math.pi, atol=1e-9, rtol=0)
+    mult = br.multiplier_real.values[:, 0]
+    assert np.allclose(mult, np.exp(8 * math.pi * s * (1 - s)), rtol=1e-6, atol=1e-12)
+    assert np.array_equal(br.stable.values == 1, X > 1)
+    assert (X > 1.2).any() and (X < 0.5).any()  # both sides of the fold
+    assert list(br.special_type.values) == [1]  # one fold
+    assert float(br.special_mu[0]) == pytest.approx(-1.0, abs=1e-8)
+    assert float(br.special_X_section[0]) == pytest.approx(1.0, abs=1e-4)
+    assert float(br.special_multiplier_real[0]) == pytest.approx(1.0, abs=1e-4)
+    from cli_helpers import one_line, run_cli
+    code, out, _ = run_cli(["continue", "--model", f"{f}:MODEL", "--param", "mu", "--section",
+                            "Y", "--crossing", "increasing", "--x0", "1.5", "--direction",
+                            "down", "--step", "0.05", "--bounds", "-1.5", "-0.05", "-o",
+                            str(tmp_path / "br.nc")], capsys)
+    assert code == 0 and "limit-cycle branch on Y = 0, increasing" in out
+    assert "fold (F)" in out and "-1.000000" in out
+    code, _, err = run_cli(["continue", "--model", f"{f}:MODEL", "--param", "mu", "--section",
+                            "Y - mu", "--x0", "1.5"], capsys)
+    assert code == 2
+    one_line(err, "names the continued parameter mu")
+
+
+def test_stick_slip_cycle_continued_in_the_belt_speed_against_its_closed_form():
+    """The Coulomb stick-slip cycle (sticking: a saltation at each switch, multiplier 0)
+    followed by pseudo-arclength continuation in the belt speed (F0 = 0: the section names the
+    self-excited case of a model with forcing): every point is the closed form's cycle."""
+    p = M.params()
+    br = ns.continuation(p, "v_belt", section="V", v0=1.0, step=0.05, bounds=(0.1, 0.4))
+    assert br.attrs["status"] == "left the bounds" and br.sizes["point"] >= 4
+    ref = np.array([coulomb_cycle(p.replace(v_belt=v)) for v in br.v_belt.values])
+    assert np.allclose(br.period.values, ref[:, 0], atol=1e-9, rtol=0)
+    assert np.allclose(br.X_section.values[:, 0], ref[:, 1], atol=1e-9, rtol=0)
+    assert np.all(br.multiplier_abs.values < 1e-9) and np.all(br.stable.values == 1)
+    assert np.all(br.contact_fraction.values > 0)  # every cycle sticks

@@ -149,6 +149,9 @@ class _Flow:
         if SEC[2] < m:
             return (f"no crossing: {int(SEC[2])} of {m} crossings of the section within "
                     f"{self.max_time:g} time units"), math.nan, U, Tc, Y
+        if not SEC[3] > 1e-9 * self.T:  # on the section and not leaving it: an equilibrium
+            return ("no crossing: the state stays on the section (an equilibrium there)",
+                    math.nan, U, Tc, Y)
         return "ok", float(SEC[3]), U, Tc, Y
 
     def field(self, state):
@@ -164,10 +167,10 @@ class _Flow:
         call_field(self.setup.fns, int(state[ST_MODE]), 0.0, 1.0, 0.0, u, self.p, mem, du)
         return du
 
-    def return_map(self, state):
-        """(status, state at the next crossing, return time, dP (n x n))."""
+    def return_map(self, state, m: int = 1):
+        """(status, state at the m-th next crossing, return time, dP (n x n))."""
         s = state.copy()
-        status, t, _, _, Y = self.crossings(s, 1, tangent=True)
+        status, t, _, _, Y = self.crossings(s, m, tangent=True)
         if status != "ok":
             return status, s, t, None
         n = self.model.n
@@ -924,3 +927,188 @@ def surface_basins(params, section="V", *, x=(-1.0, 1.0), v=(-1.0, 1.0), grid=20
                                max_time=flow.max_time, u0=base),
     )
     return apply_state_units(ds, params.model)
+
+
+class _CycleBranch:
+    """Limit cycles of a self-excited system as a branch for pseudo-arclength continuation
+    (the interface of ``continuation._Branch``): a point is y = (w, lam), the cycle's section
+    point z = z_ref + B w on the section hyperplane (B: an orthonormal basis of its directions,
+    so the n - 1 coordinates carry no multiplier of the flow direction) and the parameter;
+    F(w, lam) = B^T (P(z; lam) - z) with P the return map (k crossings), its Jacobian
+    B^T dP B - I from the tangent kernel (saltation matrices included, the flow direction
+    projected out) and dF/dlam by central differences of the map."""
+
+    def __init__(self, params, param, solver, flow, z_ref, template, k, tol, level):
+        self.params0, self.param, self.solver, self.flow = params, param, solver, flow
+        self.B = np.linalg.svd(flow.a[None, :])[2][1:].T
+        self.z_ref, self.template, self.k, self.tol, self.level = z_ref, template, k, tol, level
+        self.N = params.model.n - 1
+
+    def p(self, lam):
+        # packed afresh: a derived slot of the packed vector follows the parameter
+        return self.params0.replace(**{self.param: float(lam)}).pack()
+
+    def z(self, w):
+        return self.z_ref + self.B @ w
+
+    def _map(self, w, lam, template, tangent):
+        from ..simulate import state_u
+        from .stability import _section_state
+        flow = self.flow
+        flow.p = self.p(lam)
+        s = _section_state(flow.setup, flow.p, self.z(w), template)
+        s0 = s.copy()
+        if tangent:
+            got, s1, t1, dP = flow.return_map(s, self.k)
+        else:
+            got, t1 = flow.crossings(s, self.k)[:2]
+            s1, dP = s, None
+        if got != "ok":
+            return None
+        return s0, self.B.T @ state_u(self.params0.model, s1), t1, dP
+
+    def evaluate(self, w, lam):
+        """(F, dF/dw, dF/dlam, start state, period) at (w, lam), or None."""
+        got = self._map(w, lam, self.template, True)
+        if got is None:
+            return None
+        s0, Bz1, period, dP = got
+        F = Bz1 - self.B.T @ self.z(w)
+        J = self.B.T @ dP @ self.B - np.eye(self.N)
+        h = 1e-7 * max(1.0, abs(lam))
+        ends = []
+        for sg in (1.0, -1.0):
+            e = self._map(w, lam + sg * h, s0, False)
+            if e is None:
+                return None
+            ends.append(e[1])
+        self.flow.p = self.p(lam)
+        return F, J, (ends[0] - ends[1]) / (2.0 * h), s0, period
+
+    def correct(self, y_pred, t, base, max_iter=12):
+        """Newton's corrector onto F = 0 in the hyperplane t . (y - y_pred) = 0: (y, evaluation,
+        iterations) or None. The corrected point must lie within one step (|y_pred - base|,
+        ``base`` the corrected point the prediction steps from) of its prediction: past a fold,
+        Newton may otherwise land on an equilibrium on the section, a fixed point of the map."""
+        y = y_pred.copy()
+        N = self.N
+        reach = np.linalg.norm(y_pred - base) + 1e3 * self.tol * (1.0 + np.linalg.norm(y))
+        for it in range(1, max_iter + 1):
+            ev = self.evaluate(y[:N], y[N])
+            if ev is None:
+                return None
+            F, J, Fl = ev[:3]
+            A = np.vstack([np.hstack([J, Fl[:, None]]), t[None, :]])
+            try:
+                d = np.linalg.solve(A, -np.r_[F, t @ (y - y_pred)])
+            except np.linalg.LinAlgError:
+                return None
+            if not np.all(np.isfinite(d)):
+                return None
+            y = y + d
+            if np.linalg.norm(y - y_pred) > reach:  # wandered off: a shorter step is tried
+                return None
+            z = self.z(y[:N])
+            if (np.linalg.norm(F) <= self.tol * (1.0 + np.linalg.norm(z))
+                    and np.linalg.norm(d) <= 1e3 * self.tol * (1.0 + np.linalg.norm(y))):
+                ev = self.evaluate(y[:N], y[N])
+                if ev is None:
+                    return None
+                self.template = ev[3]
+                return y, ev, it
+        return None
+
+    def tangent(self, ev, t_prev):
+        """Unit tangent at a corrected point, oriented along t_prev."""
+        J = np.hstack([ev[1], ev[2][:, None]])
+        try:
+            v = np.linalg.solve(np.vstack([J, t_prev[None, :]]), np.r_[np.zeros(self.N), 1.0])
+        except np.linalg.LinAlgError:
+            v = t_prev.copy()
+        return v / np.linalg.norm(v)
+
+    def features(self, y, ev, t):
+        """Nontrivial multipliers, test functions and cycle features of a corrected point."""
+        from .continuation import FOLD, GRAZING, NEIMARK_SACKER, PERIOD_DOUBLING, _SAMPLES
+        _, J, _, s0, period = ev
+        mu = np.linalg.eigvals(J + np.eye(self.N))
+        mu = mu[np.argsort(-np.abs(mu), kind="stable")]
+        params = self.params0.replace(**{self.param: float(y[-1])})
+        _, R, mx, mn = _sample_cycle(params, self.solver, s0, period, _SAMPLES)
+        cm = params.model.contact_modes
+        contact = float(np.mean(((1 << R.astype(np.int64)) & cm) != 0)) if cm else 0.0
+        ns_test = 1.0
+        for i in range(len(mu)):
+            for j in range(i + 1, len(mu)):
+                ns_test *= mu[i] * mu[j] - 1.0
+        z = self.z(y[:self.N])
+        tests = {FOLD: t[-1], PERIOD_DOUBLING: float(np.real(np.prod(mu + 1.0))),
+                 NEIMARK_SACKER: float(np.real(ns_test)),
+                 GRAZING: mx - self.level if self.level is not None else math.nan}
+        return dict(mu=mu, max_X=mx, min_X=mn, contact=contact, tests=tests, period=period,
+                    section=(z[:1], z[1:2], z[None, :]))
+
+
+def cycle_continuation(params, param: str, section="V", *, k: int = 1, x0: float = 0.0,
+                       v0: float = 0.0, u0=None, transient: int = 0, direction: str = "up",
+                       step: float = 0.01, max_step: float | None = None, bounds=None,
+                       max_points: int = 400, method: str = "exact", tol: float = 1e-10,
+                       rtol: float = 1e-10, atol: float = 1e-12,
+                       max_time: float = 1e4) -> xr.Dataset:
+    """Pseudo-arclength continuation of a branch of limit cycles of a self-excited system in
+    ``param``, through folds (``continuation`` calls it for a model without forcing or with a
+    ``section``). The first cycle is :func:`limit_cycle`'s from (x0, v0) / ``u0`` after
+    ``transient`` crossings (0: 20) at ``params``; a cycle is a fixed point of the k-crossing
+    return map of ``section`` (kept as it is at the start: it must not name ``param``), its
+    period an unknown. Every point has its nontrivial Floquet multipliers (the trivial one is
+    removed by the section), and fold (a multiplier crosses +1, the branch turns), period
+    doubling, Neimark-Sacker and grazing points are located on it as for forced orbits.
+    Returns the Dataset of :func:`~nonsmooth.continuation` with ``period`` over ``point``
+    (and ``special_period``) and the attr ``section``."""
+    import re
+
+    from ..io import components
+    from .continuation import _dataset, _follow, branch_arguments
+    text0 = section[0] if isinstance(section, (tuple, list)) and section else section
+    params, solver, flow, text = _setup(params, section, method, rtol, atol, max_time,
+                                        "continuation")
+    param, k, max_points, step, max_step, tol, lo, hi = branch_arguments(
+        params, param, k, max_points, step, max_step, tol, direction, bounds)
+    if isinstance(text0, str) and param in re.findall(r"[A-Za-z_]\w*", text0):
+        raise ParameterError(f"section: {text0!r} names the continued parameter {param}: a "
+                             f"branch needs a section that stays put")
+    lc = limit_cycle(params, section, x0=x0, v0=v0, u0=u0, transient=transient or 20,
+                     method=method, tol=tol, rtol=rtol, atol=atol, max_time=max_time)
+    lam0 = float(getattr(params, param))
+    if lc.attrs["status"] != "converged":
+        raise ParameterError(f"start: no limit cycle found on {text} at {param} = {lam0:g} "
+                             f"({lc.attrs['status']}); try another start (x0, v0, u0) or "
+                             f"transient")
+    z0 = components(lc, suffix="_section").values
+    _, s_start = _start(params, solver, 0.0, 0.0, z0)
+    level = params.model.contact_level(params) if params.model.contact_level else None
+    br = _CycleBranch(params, param, solver, flow, z0, s_start, k, tol, level)
+    N = br.N
+    y = np.r_[np.zeros(N), lam0]
+    ev = br.evaluate(y[:N], y[N])
+    if ev is None:
+        raise ParameterError(f"start: the cycle at {param} = {lam0:g} has no return map on "
+                             f"{text}")
+    sign = 1.0 if direction == "up" else -1.0
+    t = br.tangent(ev, np.r_[np.zeros(N), sign])
+    if t[N] * sign < 0:
+        t = -t
+    pts = [(y, br.features(y, ev, t))]
+    br, specials, _, status = _follow(br, pts, t, step, max_step, max_points, lo, hi)
+    # the specials' points in the state's coordinates (z, lam), as for forced orbits
+    specials = [(s[0], s[1], s[2], s[3], np.r_[br.z(s[4][:N]), s[4][N]], *s[5:])
+                for s in specials]
+    ds = _dataset(params, solver, param, 1, pts, specials, status, params.model.n, direction,
+                  (lo, hi))
+    ds["period"] = ("point", np.array([f["period"] for _, f in pts]),
+                    {"long_name": "period of the limit cycle", "units": "s"})
+    for c in ("X_section", "V_section"):
+        ds[c].attrs["long_name"] = (f"{c[0]} where the cycle crosses the section")
+    ds.attrs.update(section=text, cycle_crossings=k)
+    ds.attrs["k"] = k
+    return ds

@@ -60,6 +60,7 @@ class _Branch:
                  level):
         self.setup, self.p0, self.index, self.k, self.tol, self.level = (setup, p0, index, k,
                                                                          tol, level)
+        self.N = setup.N  # coordinates of a point: the section point (state and memory)
         self.template = None
 
     def p(self, lam):
@@ -85,9 +86,10 @@ class _Branch:
         Fl = (ends[0] - ends[1]) / (2.0 * h)
         return self.setup.z_of(s1) - z, M, Fl, s0, bufs
 
-    def correct(self, y_pred, t, max_iter=12):
-        """Newton's corrector onto F = 0 in the hyperplane t . (y - y_pred) = 0. Returns
-        (y, evaluation, iterations) or None."""
+    def correct(self, y_pred, t, base=None, max_iter=12):
+        """Newton's corrector onto F = 0 in the hyperplane t . (y - y_pred) = 0 (``base``: the
+        corrected point the prediction steps from, unused here). Returns (y, evaluation,
+        iterations) or None."""
         y = y_pred.copy()
         N = self.setup.N
         for it in range(1, max_iter + 1):
@@ -176,8 +178,17 @@ def continuation(params, param: str, *, start=None, k: int = 1, x0: float = 0.0,
                  v0: float = 0.0, transient: int = 0, direction: str = "up", step: float = 0.01,
                  max_step: float | None = None, bounds=None, max_points: int = 400,
                  method: str = "exact", tol: float = 1e-10, rtol: float = 1e-10,
-                 atol: float = 1e-12, section_phase: float = 0.0, u0=None) -> xr.Dataset:
+                 atol: float = 1e-12, section_phase: float = 0.0, u0=None, section=None,
+                 max_time: float = 1e4) -> xr.Dataset:
     """Follow a branch of k-periodic orbits in ``param`` from ``params``.
+
+    A self-excited system (a model without forcing, or ``section`` given: an expression or
+    (expression, direction) as for :func:`~nonsmooth.limit_cycle`, default "V") has its limit
+    cycles followed instead, on that section surface, with their periods as unknowns
+    (:func:`nonsmooth.analysis.autonomous.cycle_continuation`: the same arclength steps,
+    special points and Dataset, plus ``period``; ``k`` = crossings per cycle, ``transient`` =
+    crossings before the first cycle's Newton search, 0: 20; ``max_time`` bounds the time to
+    the next crossing).
 
     The first point is the orbit Newton's shooting finds from (x0, v0) (or ``u0``, every
     component, see ``simulate``; after ``transient`` periods) at ``params``; with ``start=(branch, i)``, a period-doubling point ``i`` of an
@@ -200,38 +211,21 @@ def continuation(params, param: str, *, start=None, k: int = 1, x0: float = 0.0,
     over ``special`` (``special_type`` with CF flags, ``special_<param>``, the multiplier
     nearest the crossing and the point index after which it lies); attrs ``status`` (why the
     branch ended)."""
-    from ..simulate import check_forced
-    check_forced(params, "continuation")
+    from ..simulate import check_params
+    if section is not None or check_params(params).model.autonomous:
+        from .autonomous import cycle_continuation
+        return cycle_continuation(params, param, "V" if section is None else section, k=k,
+                                  x0=x0, v0=v0, u0=u0, transient=transient,
+                                  direction=direction, step=step, max_step=max_step,
+                                  bounds=bounds, max_points=max_points, method=method, tol=tol,
+                                  rtol=rtol, atol=atol, max_time=max_time)
     params, solver, p0, opts, state = start_trajectory(params, x0, v0, method, rtol, atol,
                                                        section_phase, u0)
     u_start = state_u(params.model, state)
-    if not isinstance(param, str):
-        raise ParameterError(f"param: expected a parameter name, got {param!r}")
-    param = params.model.param(param).name
-    k = check_int("k", k, 1)
-    max_points = check_int("max_points", max_points, 2)
-    step = check_float("step", step)
-    if not step > 0:
-        raise ParameterError(f"step: must be > 0, got {step}")
-    max_step = 10.0 * step if max_step is None else check_float("max_step", max_step)
-    if not max_step >= step:
-        raise ParameterError(f"max_step: must be >= step = {step:g}, got {max_step:g}")
-    tol = check_float("tol", tol)
-    if not tol > 0:
-        raise ParameterError(f"tol: must be > 0, got {tol}")
-    if direction not in ("up", "down"):
-        raise ParameterError(f"direction: expected 'up' or 'down', got {direction!r}")
+    param, k, max_points, step, max_step, tol, lo, hi = branch_arguments(
+        params, param, k, max_points, step, max_step, tol, direction, bounds, start is None)
+    bounds = (lo, hi)
     lam0 = float(getattr(params, param))
-    if bounds is None:
-        bounds = (-math.inf, math.inf)
-    try:
-        lo, hi = (float(b) for b in bounds)
-    except (TypeError, ValueError):
-        raise ParameterError(f"bounds: expected (low, high), got {bounds!r}") from None
-    if math.isnan(lo) or math.isnan(hi) or not lo < hi:
-        raise ParameterError(f"bounds: expected low < high, got ({lo:g}, {hi:g})")
-    if start is None and not lo <= lam0 <= hi:
-        raise ParameterError(f"bounds: ({lo:g}, {hi:g}) exclude the start {param} = {lam0:g}")
     setup = TangentSetup(solver)
     index = params.model.index[param]
     level = params.model.contact_level(params) if params.model.contact_level else None
@@ -269,6 +263,45 @@ def continuation(params, param: str, *, start=None, k: int = 1, x0: float = 0.0,
     f_start = br.features(y, ev, t)
     f_start["phase"] = phase
     pts = [(y, f_start)]
+    moved_to = {"solver": solver}
+
+    def relocate(br, y0, t):
+        # an event on the section (e.g. an impact at t = kT) makes the map non-smooth there:
+        # move the section by a quarter period and go on from the same orbit
+        moved = _moved_section(br, moved_to["solver"], y0, t, step)
+        if moved is None:
+            return None
+        moved_to["solver"], _, br, y0, t, got, ds = moved
+        return br, y0, t, got, ds, moved_to["solver"].section_phase
+
+    br, specials, moves, status = _follow(br, pts, t, step, max_step, max_points, lo, hi,
+                                          relocate)
+    solver = moved_to["solver"]
+    ds = _dataset(params, solver, param, k, pts, specials, status, N, direction, bounds)
+    if moves:
+        ds["section_phase"] = ("point", np.array([f["phase"] for _, f in pts]), {
+            "long_name": "forcing phase omega t_s of the section of each point (moved off "
+                         "events that fell on the section)", "units": "rad"})
+        ds.attrs["section_moved"] = "; ".join(f"after point {i}: to {ph:.6g} rad"
+                                              for i, ph in moves)
+        ds["special_section_phase"] = ("special", np.array([sp[-1] for sp in specials], float),
+                                       {"long_name": "forcing phase of the section where the "
+                                                     "special point was located", "units": "rad"})
+        ds.attrs["section_phase"] = float(section_phase)
+    return ds
+
+
+def _follow(br, pts, t, step, max_step, max_points, lo, hi, relocate=None):
+    """Pseudo-arclength steps from the last of ``pts`` ((y, features) pairs; y = the branch's
+    coordinates, then the parameter) along the unit tangent ``t``, appending each corrected
+    point, until ``max_points``, the parameter leaves (lo, hi), or the corrector fails even at
+    step x MIN_STEP and ``relocate(br, y, t)`` (if given) offers no way on (else it returns
+    (branch, y, t, corrected point, step, section phase)). The step adapts to the corrector's
+    iterations; sign changes of the test functions between points are located
+    (:func:`_locate`). ``br`` has ``N`` (coordinates), ``correct``, ``tangent`` and
+    ``features`` (see :class:`_Branch`). Returns (branch, specials, moves, status)."""
+    N = br.N
+    phase = pts[-1][1].get("phase")
     specials = []
     moves = []  # (point index, new section phase): where the section was moved off an event
     ds = step
@@ -277,19 +310,16 @@ def continuation(params, param: str, *, start=None, k: int = 1, x0: float = 0.0,
         y0, f0 = pts[-1]
         got = None
         while ds >= step * MIN_STEP:
-            got = br.correct(y0 + ds * t, t)
+            got = br.correct(y0 + ds * t, t, y0)
             if got is not None:
                 break
             ds *= 0.5
         if got is None:
-            # an event on the section (e.g. an impact at t = kT) makes the map non-smooth
-            # there: move the section by a quarter period and go on from the same orbit
-            moved = _moved_section(br, solver, y0, t, step)
+            moved = relocate(br, y0, t) if relocate is not None else None
             if moved is None:
                 status = f"cannot continue (the corrector fails even at step x {MIN_STEP:g})"
                 break
-            solver, setup, br, y0, t, got, ds = moved
-            phase = solver.section_phase
+            br, y0, t, got, ds, phase = moved
             moves.append((len(pts) - 1, phase))
         y1, ev1, iters = got
         t1 = br.tangent(ev1, t)
@@ -307,18 +337,42 @@ def continuation(params, param: str, *, start=None, k: int = 1, x0: float = 0.0,
             status = "left the bounds"
             break
         ds = min(max_step, ds * 1.5) if iters <= 3 else (ds * 0.5 if iters > 6 else ds)
-    ds = _dataset(params, solver, param, k, pts, specials, status, N, direction, bounds)
-    if moves:
-        ds["section_phase"] = ("point", np.array([f["phase"] for _, f in pts]), {
-            "long_name": "forcing phase omega t_s of the section of each point (moved off "
-                         "events that fell on the section)", "units": "rad"})
-        ds.attrs["section_moved"] = "; ".join(f"after point {i}: to {ph:.6g} rad"
-                                              for i, ph in moves)
-        ds["special_section_phase"] = ("special", np.array([sp[-1] for sp in specials], float),
-                                       {"long_name": "forcing phase of the section where the "
-                                                     "special point was located", "units": "rad"})
-        ds.attrs["section_phase"] = float(section_phase)
-    return ds
+    return br, specials, moves, status
+
+
+def branch_arguments(params, param, k, max_points, step, max_step, tol, direction, bounds,
+                     check_start: bool = True):
+    """The checked arguments of a branch: (param, k, max_points, step, max_step, tol, lo, hi);
+    one-line ParameterErrors naming the field (``check_start``: the bounds must contain the
+    parameter's value in ``params``)."""
+    if not isinstance(param, str):
+        raise ParameterError(f"param: expected a parameter name, got {param!r}")
+    param = params.model.param(param).name
+    k = check_int("k", k, 1)
+    max_points = check_int("max_points", max_points, 2)
+    step = check_float("step", step)
+    if not step > 0:
+        raise ParameterError(f"step: must be > 0, got {step}")
+    max_step = 10.0 * step if max_step is None else check_float("max_step", max_step)
+    if not max_step >= step:
+        raise ParameterError(f"max_step: must be >= step = {step:g}, got {max_step:g}")
+    tol = check_float("tol", tol)
+    if not tol > 0:
+        raise ParameterError(f"tol: must be > 0, got {tol}")
+    if direction not in ("up", "down"):
+        raise ParameterError(f"direction: expected 'up' or 'down', got {direction!r}")
+    lam0 = float(getattr(params, param))
+    if bounds is None:
+        bounds = (-math.inf, math.inf)
+    try:
+        lo, hi = (float(b) for b in bounds)
+    except (TypeError, ValueError):
+        raise ParameterError(f"bounds: expected (low, high), got {bounds!r}") from None
+    if math.isnan(lo) or math.isnan(hi) or not lo < hi:
+        raise ParameterError(f"bounds: expected low < high, got ({lo:g}, {hi:g})")
+    if check_start and not lo <= lam0 <= hi:
+        raise ParameterError(f"bounds: ({lo:g}, {hi:g}) exclude the start {param} = {lam0:g}")
+    return param, k, max_points, step, max_step, tol, lo, hi
 
 
 def _moved_section(br, solver, y, t, step):
@@ -449,7 +503,7 @@ def _locate(br, typ, y0, t0, ds, a, b):
     mu_sides = [None, None]  # multipliers at the last point found on each side
     for _ in range(60):
         s = illinois_point(lo, hi, glo, ghi)
-        got = br.correct(y0 + s * t0, t0)
+        got = br.correct(y0 + s * t0, t0, y0)
         if got is None:
             return None
         y, ev, _ = got

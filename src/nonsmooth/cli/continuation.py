@@ -14,6 +14,7 @@ from .app import app
 from .common import (U0Opt, DEFAULT_MODEL, SectionPhaseOpt, AtolOpt, ModelOpt, OutOpt, PlotOpt, PresetOpt, RtolOpt, SetOpt,
                      check_outputs, echo_written, load_params, preset_label, resolve_method,
                      save_outputs)
+from .autonomous import MaxTimeOpt
 from .stability import OrbitMethodOpt, _num, print_table
 
 #: Words for the special-point types (CF flag values of ``special_type``).
@@ -81,6 +82,16 @@ def continue_cmd(
     special: Annotated[str, typer.Option(
         "--special", help="fold, period_doubling, neimark_sacker or grazing (--two-param)")]
     = "fold",
+    section: Annotated[Optional[str], typer.Option(
+        "--section", show_default=False,
+        help="limit cycles of a self-excited system on this section surface (an expression "
+             "affine in the state, e.g. V; default V for a model without forcing): --k is "
+             "then crossings per cycle and --transient crossings before the first Newton "
+             "search")] = None,
+    crossing: Annotated[str, typer.Option(
+        "--crossing", help="with --section: the crossings counted, decreasing, increasing "
+                           "or both")] = "decreasing",
+    max_time: MaxTimeOpt = 1e4,
     out: OutOpt = None,
     plot: PlotOpt = None,
 ):
@@ -88,7 +99,8 @@ def continue_cmd(
     preset's value (Newton shooting from (x0, v0)): pseudo-arclength, through folds, with the
     Floquet multipliers and stability of every point and the special points located on it
     (fold, period doubling, Neimark-Sacker, grazing); the branch figure, stable solid,
-    unstable dashed."""
+    unstable dashed. With --section (or a model without forcing): the limit cycles of a
+    self-excited system on that section surface, their periods unknowns."""
     from ..analysis.continuation import continuation
     from ..simulate import check_float, check_int
 
@@ -117,17 +129,25 @@ def continue_cmd(
                               step, bounds, max_points, method, tol, out, plot, section_phase,
                               u0)
     check_outputs(out, plot)
+    cycles = section is not None or params.model.autonomous
     ds = continuation(params, param, k=k, x0=x0, v0=v0, u0=u0, transient=transient,
                       direction=direction, step=step, max_step=max_step, bounds=bounds,
                       max_points=max_points, method=method, tol=tol, rtol=rtol, atol=atol,
-                      section_phase=section_phase)
+                      section_phase=section_phase,
+                      section=(section or "V", crossing) if cycles else None,
+                      max_time=max_time)
     from ..plot.continuation import plot_continuation
     save_outputs(ds, preset, out, plot, plot_continuation)
     lam = ds[param].values
     stable = ds["stable"].values.astype(bool)
-    typer.echo(f"{preset} ({method}): period-{k} branch in {param}, {lam.size} points from "
+    what = (f"limit-cycle branch on {ds.attrs['section']}" if cycles
+            else f"period-{k} branch")
+    typer.echo(f"{preset} ({method}): {what} in {param}, {lam.size} points from "
                f"{param} = {lam[0]:.6g} to {lam[-1]:.6g} (range {lam.min():.6g} ... "
                f"{lam.max():.6g}), {int(stable.sum())} stable, {int((~stable).sum())} unstable")
+    if cycles:
+        T = ds["period"].values
+        typer.echo(f"periods {float(T.min()):.6g} ... {float(T.max()):.6g}")
     typer.echo(f"status: {ds.attrs['status']}")
     if "section_moved" in ds.attrs:
         typer.echo(f"section moved off an event on it: {ds.attrs['section_moved']}")

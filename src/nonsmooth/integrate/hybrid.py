@@ -703,14 +703,15 @@ def _immediate_exit(G, ng, n, u, f0, C, S, om):
 @nb.njit(cache=True, inline="always")
 def _section_side(G, k, H, n, u, f, C, S, om):
     """Orientation (+-1) of the section row h = H . (u, 1, C, S) written to G[k]: the side of
-    the surface the state is on, or, within round-off of the surface (a state stopped on a
-    crossing, a reset onto it), the side it moves to (h')."""
+    the surface the state is on, or, within round-off of the surface (|h| <= 1e-9 of the
+    terms' scale: a state stopped on a crossing, a reset onto it, a section point from a Newton
+    step), the side it moves to (h')."""
     for i in range(n + 3):
         G[k, i] = H[i]
     h = _gval(G, k, n, u, C, S)
     scale = abs(H[n]) + abs(H[n + 1]) + abs(H[n + 2])
-    for i in range(n):
-        scale += abs(H[i] * u[i])
+    for i in range(n):  # (each coefficient counts, also where its component is 0: a surface
+        scale += abs(H[i]) * (1.0 + abs(u[i]))  # through the origin, V = 0, is no exception)
     sgn = 1.0
     if abs(h) <= 1e-9 * scale:
         if _dgval(G, k, n, f, C, S, om) < 0.0:
