@@ -231,3 +231,29 @@ def test_cli_poincare_and_resonance_write_outputs(tmp_path, capsys):
     assert (tmp_path / "p.nc").stat().st_size > 0 and (tmp_path / "p.png").stat().st_size > 0
     ds = ns.io.load_dataset(tmp_path / "p.nc")
     assert ds["period"] == 3 and ds.attrs["preset"] == "table3"
+
+
+def _oscillator_and_passenger(k2):
+    """X'' + 0.2 X' + X = F0 cos(omega t) beside an undamped passenger Z'' = -k2 Z that X
+    and V do not see: the section's (X, V) settle to period 1 whatever k2; the whole state is
+    periodic only if the passenger's frequency is a multiple of omega (k2 = 4 at omega = 1)."""
+    return ns.model_from_equations(
+        f"passenger_{k2:g}".replace(".", "_"), states=("X", "V", "Z", "W"),
+        parameters={"F0": 0.5, "omega": 1.0, "k2": k2},
+        modes={"free": ["V", "-0.2*V - X + F0*cos(omega*t)", "W", "-k2*Z"]}, method="smooth",
+        closed_form=False)
+
+
+@pytest.mark.parametrize("k2, period", [(4.0, 1), (2.0, 0)])
+def test_a_period_is_that_of_every_state_component(k2, period):
+    """Issue 23, item 2: a model with more than X and V is periodic only if every component
+    repeats, not only the section's (X, V): with an incommensurate passenger the bifurcation
+    diagram, the Poincaré map and the parameter map find no period; with a commensurate one,
+    period 1."""
+    p = _oscillator_and_passenger(k2).params()
+    u0 = (0.0, 0.0, 1.0, 0.0)
+    bd = ns.bifurcation_diagram(p, "F0", [0.4, 0.5], sweep="up", transient=200, record=40,
+                                u0=u0, lyapunov=False)
+    assert np.all(bd.period.values == period)
+    pm = ns.poincare(p, transient=200, record=40, u0=u0, lyapunov=False)
+    assert int(pm.period) == period

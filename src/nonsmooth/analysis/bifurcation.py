@@ -469,9 +469,33 @@ def summarize(out, rows, solver: Solver, transient: int, record: int, workers=No
         todo = [q for points in pending.values() for q in points]
         if not todo:
             break
+    if model.n > 2:
+        _confirm_full_state(out, rows, solver, period, workers)
     failed = out["status"] != st.OK
     period[failed], contact[failed], mx[failed], mn[failed] = 0, 0, np.nan, np.nan
     return period, mx, mn, contact
+
+
+def _confirm_full_state(out, rows, solver: Solver, period, workers=None) -> None:
+    """A model with more state components than X and V: a period p found on the section's
+    (X, V) must repeat every component too. Each such point is integrated p periods on from
+    its final state (``out["S"]``, on the section) and each component compared with the
+    section tolerance of :func:`~.periodicity.detect_period`; where one differs (a component
+    that X and V do not see, or barely), the point is not periodic (``period`` 0, in place)."""
+    from ..integrate.contract import ST_EXTRA, ST_V, ST_X
+    from ..sweep import run_trajectories
+    from .periodicity import section_tolerance
+    cols = [ST_X, ST_V] + list(range(ST_EXTRA, ST_EXTRA + solver.model.n - 2))
+    for p in np.unique(period[period > 0]).tolist():
+        idx = tuple(np.argwhere(period == p).T)
+        S = out["S"][idx]
+        res = run_trajectories(rows[idx], solver, S, per_period=1, n_skip=int(p), n_out=0,
+                               workers=workers)
+        U0, U1 = S[:, cols], res["state"][:, cols]
+        tol = np.array([section_tolerance(solver.rtol, solver.atol, float(np.max(np.abs(u))))
+                        for u in U0])
+        same = (res["status"] == st.OK) & np.all(np.abs(U1 - U0) <= tol[:, None], axis=1)
+        period[tuple(a[~same] for a in idx)] = 0
 
 
 class _LazyParams:
