@@ -257,3 +257,6 @@ def test_a_period_is_that_of_every_state_component(k2, period):
     assert np.all(bd.period.values == period)
     pm = ns.poincare(p, transient=200, record=40, u0=u0, lyapunov=False)
     assert int(pm.period) == period
+    mp = ns.parameter_map(p, x=("F0", 0.4, 0.5, 2), y=("k2", k2, k2 * (1 + 1e-9), 2),
+                          transient=200, record=40, u0=u0, lyapunov=False)
+    assert np.all(mp.period.values == period)

@@ -422,3 +422,14 @@ def test_stick_slip_cycle_continued_in_the_belt_speed_against_its_closed_form():
     assert np.allclose(br.X_section.values[:, 0], ref[:, 1], atol=1e-9, rtol=0)
     assert np.all(br.multiplier_abs.values < 1e-9) and np.all(br.stable.values == 1)
     assert np.all(br.contact_fraction.values > 0)  # every cycle sticks
+    assert br.v_belt.values[-1] > 0.4 and np.all(np.diff(br.v_belt.values) > 0)  # "up"
+    # at the lower limit of a parameter's range (xi = 0): a one-sided dF/dlam
+    up = ns.continuation(p, "xi", section="V", v0=1.0, step=0.02, bounds=(0.0, 0.05))
+    assert up.sizes["point"] >= 2 and float(up.xi[0]) == 0.0
+    assert float(up.period[0]) == pytest.approx(coulomb_cycle(p)[0], abs=1e-9)
+    for kw, field in ((dict(k=2), "k"), (dict(start=(up, 0)), "start"),
+                      (dict(section_phase=1.0), "section_phase")):
+        with pytest.raises(ParameterError, match=f"^{field}: "):
+            ns.continuation(p, "v_belt", section="V", v0=1.0, **kw)
+    with pytest.raises(ParameterError, match="^param: F0 is the forcing's"):
+        ns.continuation(p, "F0", section="V", v0=1.0)

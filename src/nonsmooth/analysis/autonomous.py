@@ -955,7 +955,10 @@ class _CycleBranch:
         from ..simulate import state_u
         from .stability import _section_state
         flow = self.flow
-        flow.p = self.p(lam)
+        try:
+            flow.p = self.p(lam)
+        except ParameterError:  # outside the parameter's range: no map there
+            return None
         s = _section_state(flow.setup, flow.p, self.z(w), template)
         s0 = s.copy()
         if tangent:
@@ -976,14 +979,15 @@ class _CycleBranch:
         F = Bz1 - self.B.T @ self.z(w)
         J = self.B.T @ dP @ self.B - np.eye(self.N)
         h = 1e-7 * max(1.0, abs(lam))
-        ends = []
-        for sg in (1.0, -1.0):
-            e = self._map(w, lam + sg * h, s0, False)
-            if e is None:
-                return None
-            ends.append(e[1])
+        up, down = (self._map(w, lam + sg * h, s0, False) for sg in (1.0, -1.0))
         self.flow.p = self.p(lam)
-        return F, J, (ends[0] - ends[1]) / (2.0 * h), s0, period
+        if up is not None and down is not None:
+            Fl = (up[1] - down[1]) / (2.0 * h)
+        elif up is not None or down is not None:  # at a limit of the parameter's range:
+            Fl = ((up[1] - Bz1) if up is not None else (Bz1 - down[1])) / h  # one-sided
+        else:
+            return None
+        return F, J, Fl, s0, period
 
     def correct(self, y_pred, t, base, max_iter=12):
         """Newton's corrector onto F = 0 in the hyperplane t . (y - y_pred) = 0: (y, evaluation,
@@ -1030,10 +1034,14 @@ class _CycleBranch:
     def features(self, y, ev, t):
         """Nontrivial multipliers, test functions and cycle features of a corrected point."""
         from .continuation import FOLD, GRAZING, NEIMARK_SACKER, PERIOD_DOUBLING, _SAMPLES
+        from ..kernels import run
         _, J, _, s0, period = ev
         mu = np.linalg.eigvals(J + np.eye(self.N))
         mu = mu[np.argsort(-np.abs(mu), kind="stable")]
         params = self.params0.replace(**{self.param: float(y[-1])})
+        s0 = s0.copy()  # its mode classified (-1: left to the kernel) before it is sampled
+        run(KERNEL_GENERIC, self.solver.fns, params.pack(), self.solver.opts(), s0, 1, 0, 0,
+            *output_buffers(0))
         _, R, mx, mn = _sample_cycle(params, self.solver, s0, period, _SAMPLES)
         cm = params.model.contact_modes
         contact = float(np.mean(((1 << R.astype(np.int64)) & cm) != 0)) if cm else 0.0
@@ -1064,7 +1072,9 @@ def cycle_continuation(params, param: str, section="V", *, k: int = 1, x0: float
     removed by the section), and fold (a multiplier crosses +1, the branch turns), period
     doubling, Neimark-Sacker and grazing points are located on it as for forced orbits.
     Returns the Dataset of :func:`~nonsmooth.continuation` with ``period`` over ``point``
-    (and ``special_period``) and the attr ``section``."""
+    and the attr ``section``. ``k`` must be 1 (a cycle that crosses the section several times
+    is followed on a section it crosses once); branch switching (``start``) and section
+    phases are for forced orbits."""
     import re
 
     from ..io import components
@@ -1074,6 +1084,13 @@ def cycle_continuation(params, param: str, section="V", *, k: int = 1, x0: float
                                         "continuation")
     param, k, max_points, step, max_step, tol, lo, hi = branch_arguments(
         params, param, k, max_points, step, max_step, tol, direction, bounds)
+    if k != 1:
+        raise ParameterError(f"k: limit cycles are fixed points of the section's one-crossing "
+                             f"return map, got k = {k}: choose a section the cycle crosses "
+                             f"once (k = 1)")
+    if param in (params.model.forcing_amplitude, params.model.omega):
+        raise ParameterError(f"param: {param} is the forcing's; a branch of a self-excited "
+                             f"system follows one of its own parameters")
     if isinstance(text0, str) and param in re.findall(r"[A-Za-z_]\w*", text0):
         raise ParameterError(f"section: {text0!r} names the continued parameter {param}: a "
                              f"branch needs a section that stays put")

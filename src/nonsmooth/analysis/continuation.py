@@ -214,6 +214,10 @@ def continuation(params, param: str, *, start=None, k: int = 1, x0: float = 0.0,
     from ..simulate import check_params
     if section is not None or check_params(params).model.autonomous:
         from .autonomous import cycle_continuation
+        if start is not None or section_phase != 0.0:
+            raise ParameterError(f"{'start' if start is not None else 'section_phase'}: "
+                                 f"branch switching and section phases are for forced orbits, "
+                                 f"not limit cycles on a section surface")
         return cycle_continuation(params, param, "V" if section is None else section, k=k,
                                   x0=x0, v0=v0, u0=u0, transient=transient,
                                   direction=direction, step=step, max_step=max_step,

@@ -125,6 +125,10 @@ def continue_cmd(
         raise ParameterError(f"bounds: {bounds[0]:g} ... {bounds[1]:g} exclude the start "
                              f"{param} = {lam0:g} (set it with --set {param}=VALUE)")
     if two_param is not None:
+        if section is not None:
+            raise ParameterError("section: --two-param follows special points of forced "
+                                 "orbits; limit cycles on a --section are followed in one "
+                                 "parameter")
         return _two_parameter(params, preset, param, two_param, values, special, k, x0, v0,
                               step, bounds, max_points, method, tol, out, plot, section_phase,
                               u0)
