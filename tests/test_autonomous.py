@@ -433,3 +433,20 @@ def test_stick_slip_cycle_continued_in_the_belt_speed_against_its_closed_form():
             ns.continuation(p, "v_belt", section="V", v0=1.0, **kw)
     with pytest.raises(ParameterError, match="^param: F0 is the forcing's"):
         ns.continuation(p, "F0", section="V", v0=1.0)
+
+
+def test_fold_of_cycles_followed_in_two_parameters_against_the_closed_form():
+    """r' = r (mu + nu r^2 - r^4): cycles where s^2 - nu s - mu = 0 (s = r^2), a fold of
+    cycles at mu = -nu^2/4 (s = nu/2). ``two_parameter_curve`` locates it on the cycle branch
+    at each nu."""
+    m = ns.model_from_equations(
+        "fold_of_cycles_2", states=("X", "Y"), parameters={"mu": -0.5, "nu": 2.0},
+        modes={"flow": ["X*(mu + nu*(X**2 + Y**2) - (X**2 + Y**2)**2) - Y",
+                        "Y*(mu + nu*(X**2 + Y**2) - (X**2 + Y**2)**2) + X"]}, omega=None)
+    nus = np.array([1.6, 2.0, 2.4])
+    curve = ns.two_parameter_curve(m.params(), "mu", "nu", nus, section=("Y", "increasing"),
+                                   x0=2.0, direction="down", step=0.05, bounds=(-2.0, -0.1))
+    assert curve.attrs["section"] == "Y = 0, increasing"
+    assert np.allclose(curve.mu.values[:, 0], -nus**2 / 4, atol=1e-8, rtol=0)
+    assert np.all(np.isnan(curve.mu.values[:, 1:]))  # one fold per branch
+    assert np.allclose(curve.multiplier_real.values[:, 0], 1.0, atol=1e-4)

@@ -616,7 +616,8 @@ def two_parameter_curve(params, param: str, param2: str, values2, *, special: st
                         k: int = 1, x0: float = 0.0, v0: float = 0.0, bounds=None,
                         step: float = 0.01, max_points: int = 400, method: str = "exact",
                         tol: float = 1e-10, section_phase: float = 0.0,
-                        u0=None) -> xr.Dataset:
+                        u0=None, direction: str = "up", section=None,
+                        max_time: float = 1e4) -> xr.Dataset:
     """A curve of special points in two parameters: for each value of ``param2`` in
     ``values2``, the branch in ``param`` is continued from the same start (``params``' value
     of ``param``, Newton from (x0, v0) or ``u0``) over ``bounds`` and every located point of type
@@ -627,9 +628,12 @@ def two_parameter_curve(params, param: str, param2: str, values2, *, special: st
     Returns a Dataset over (``param2``, ``n``): ``<param>`` at the n-th such point of the branch
     (in ascending order; NaN where fewer were found), the critical multiplier and
     ``special_jump``; ``status`` per value of ``param2`` (how the branch ended). Each point is
-    located to 1e-10 on its branch; the curve is as fine as ``values2``."""
-    from ..simulate import check_forced
-    check_forced(params, "two_parameter_curve")
+    located to 1e-10 on its branch; the curve is as fine as ``values2``. Each branch runs
+    ``direction`` ("up", "down") from the start. A self-excited system (a model without
+    forcing, or ``section`` given) has the special points of its limit cycles on that section
+    followed instead (see :func:`continuation`)."""
+    from ..simulate import check_params
+    check_params(params)
     names = {v: kk for kk, v in SPECIAL_NAMES.items()}
     if special not in names or names[special] == 0:
         raise ParameterError(f"special: expected one of fold, period_doubling, "
@@ -648,7 +652,8 @@ def two_parameter_curve(params, param: str, param2: str, values2, *, special: st
         p = params.replace(**{param2: float(v)})
         br = continuation(p, param, k=k, x0=x0, v0=v0, u0=u0, bounds=bounds, step=step,
                           max_points=max_points, method=method, tol=tol,
-                          section_phase=section_phase)
+                          section_phase=section_phase, direction=direction, section=section,
+                          max_time=max_time)
         sel = br.special_type.values == typ
         lam = br[f"special_{param}"].values[sel]
         mu = (br.special_multiplier_real.values + 1j * br.special_multiplier_imag.values)[sel]
@@ -678,5 +683,7 @@ def two_parameter_curve(params, param: str, param2: str, values2, *, special: st
                 "n": np.arange(n)},
         attrs=provenance_attrs(params, None, swept=(param, param2), section_phase=section_phase,
                                analysis="two_parameter_curve", param=param, param2=param2,
-                               special=special, k=k),
+                               special=special, k=k, direction=direction,
+                               **({"section": br.attrs["section"]} if "section" in br.attrs
+                                  else {})),
     )

@@ -124,22 +124,17 @@ def continue_cmd(
     if bounds is not None and not bounds[0] <= lam0 <= bounds[1]:
         raise ParameterError(f"bounds: {bounds[0]:g} ... {bounds[1]:g} exclude the start "
                              f"{param} = {lam0:g} (set it with --set {param}=VALUE)")
+    cycles = section is not None or params.model.autonomous
+    sec = (section or "V", crossing) if cycles else None
     if two_param is not None:
-        if section is not None:
-            raise ParameterError("section: --two-param follows special points of forced "
-                                 "orbits; limit cycles on a --section are followed in one "
-                                 "parameter")
         return _two_parameter(params, preset, param, two_param, values, special, k, x0, v0,
                               step, bounds, max_points, method, tol, out, plot, section_phase,
-                              u0)
+                              u0, direction, sec, max_time)
     check_outputs(out, plot)
-    cycles = section is not None or params.model.autonomous
     ds = continuation(params, param, k=k, x0=x0, v0=v0, u0=u0, transient=transient,
                       direction=direction, step=step, max_step=max_step, bounds=bounds,
                       max_points=max_points, method=method, tol=tol, rtol=rtol, atol=atol,
-                      section_phase=section_phase,
-                      section=(section or "V", crossing) if cycles else None,
-                      max_time=max_time)
+                      section_phase=section_phase, section=sec, max_time=max_time)
     from ..plot.continuation import plot_continuation
     save_outputs(ds, preset, out, plot, plot_continuation)
     lam = ds[param].values
@@ -172,7 +167,8 @@ def continue_cmd(
 
 
 def _two_parameter(params, preset, param, param2, values, special, k, x0, v0, step, bounds,
-                   max_points, method, tol, out, plot, section_phase=0.0, u0=None):
+                   max_points, method, tol, out, plot, section_phase=0.0, u0=None,
+                   direction="up", section=None, max_time=1e4):
     """``nonsmooth continue --two-param``: the curve of --special points in (param, param2)."""
     import numpy as np
 
@@ -188,7 +184,8 @@ def _two_parameter(params, preset, param, param2, values, special, k, x0, v0, st
     ds = two_parameter_curve(params, param, param2, grid, special=special, k=k, x0=x0, v0=v0,
                              u0=u0,
                              bounds=bounds, step=step, max_points=max_points, method=method,
-                             tol=tol, section_phase=section_phase)
+                             tol=tol, section_phase=section_phase, direction=direction,
+                             section=section, max_time=max_time)
     save_outputs(ds, preset, out, plot, plot_two_parameter)
     found = int(np.isfinite(ds[param].values).any(axis=1).sum())
     typer.echo(f"{preset} ({method}): {special} points in ({param}, {param2}) at {found} of "
