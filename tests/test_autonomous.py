@@ -397,6 +397,12 @@ def test_limit_cycles_continued_through_their_fold_against_the_closed_form(tmp_p
     assert float(br.special_mu[0]) == pytest.approx(-1.0, abs=1e-8)
     assert float(br.special_X_section[0]) == pytest.approx(1.0, abs=1e-4)
     assert float(br.special_multiplier_real[0]) == pytest.approx(1.0, abs=1e-4)
+    # the same cycles on Y = 0 counted both ways: two crossings per turn (k = 2)
+    both = ns.continuation(p, "mu", section=("Y", "both"), k=2, x0=1.5, direction="down",
+                           step=0.05, bounds=(-1.5, -0.5))
+    assert np.allclose(both.period.values, 2 * math.pi, atol=1e-9, rtol=0)
+    assert list(both.special_type.values) == [1]
+    assert float(both.special_mu[0]) == pytest.approx(-1.0, abs=1e-8)
     from cli_helpers import one_line, run_cli
     code, out, _ = run_cli(["continue", "--model", f"{f}:MODEL", "--param", "mu", "--section",
                             "Y", "--crossing", "increasing", "--x0", "1.5", "--direction",
@@ -427,8 +433,8 @@ def test_stick_slip_cycle_continued_in_the_belt_speed_against_its_closed_form():
     up = ns.continuation(p, "xi", section="V", v0=1.0, step=0.02, bounds=(0.0, 0.05))
     assert up.sizes["point"] >= 2 and float(up.xi[0]) == 0.0
     assert float(up.period[0]) == pytest.approx(coulomb_cycle(p)[0], abs=1e-9)
-    for kw, field in ((dict(k=2), "k"), (dict(start=(up, 0)), "start"),
-                      (dict(section_phase=1.0), "section_phase")):
+    for kw, field in ((dict(start=(up, 0)), "start"), (dict(section_phase=1.0),
+                                                       "section_phase")):
         with pytest.raises(ParameterError, match=f"^{field}: "):
             ns.continuation(p, "v_belt", section="V", v0=1.0, **kw)
     with pytest.raises(ParameterError, match="^param: F0 is the forcing's"):

@@ -387,10 +387,11 @@ def surface_bifurcation_diagram(params, param: str, values, section="V", *,
 def limit_cycle(params, section="V", *, x0: float = 0.0, v0: float = 0.0, u0=None,
                 transient: int = 20, method: str = "exact", tol: float = 1e-10,
                 max_iter: int = 40, rtol: float = 1e-10, atol: float = 1e-12,
-                max_time: float = 1e4, samples: int = 400) -> xr.Dataset:
+                max_time: float = 1e4, samples: int = 400, crossings: int = 1) -> xr.Dataset:
     """A limit cycle of a self-excited system, stable or unstable, with its period, by Newton
     shooting on ``section`` (see the module docstring) from the ``transient``-th crossing of
-    the trajectory from (x0, v0) (or ``u0``).
+    the trajectory from (x0, v0) (or ``u0``): a fixed point of the ``crossings``-th return
+    (a cycle that crosses the section that many times per turn, e.g. both ways).
 
     Returns a Dataset: ``period``, the section point (``X_section``, ``V_section``, ...), the
     nontrivial
@@ -409,6 +410,7 @@ def limit_cycle(params, section="V", *, x0: float = 0.0, v0: float = 0.0, u0=Non
     transient = check_int("transient", transient, 1)
     max_iter = check_int("max_iter", max_iter, 1)
     samples = check_int("samples", samples, 2)
+    crossings = check_int("crossings", crossings, 1)
     tol = check_float("tol", tol)
     if not tol > 0:
         raise ParameterError(f"tol: must be > 0, got {tol}")
@@ -424,7 +426,7 @@ def limit_cycle(params, section="V", *, x0: float = 0.0, v0: float = 0.0, u0=Non
         status = "max_iter"
         for it in range(1, max_iter + 1):
             z = state_u(params.model, s)
-            got, s1, t1, dP = flow.return_map(s)
+            got, s1, t1, dP = flow.return_map(s, crossings)
             if got != "ok":
                 status = got
                 break
@@ -443,7 +445,7 @@ def limit_cycle(params, section="V", *, x0: float = 0.0, v0: float = 0.0, u0=Non
             def trial(zt):
                 st_t = _section_state(flow.setup, flow.p, zt, s)  # mode kept if it holds
                 s1t = st_t.copy()
-                got_t = flow.crossings(s1t, 1)[0]
+                got_t = flow.crossings(s1t, crossings)[0]
                 return st_t, (float(np.linalg.norm(state_u(params.model, s1t) - zt))
                               if got_t == "ok" else math.inf)
             zt, st_t = damped_step(z, B @ dw, res, trial)
@@ -465,7 +467,7 @@ def limit_cycle(params, section="V", *, x0: float = 0.0, v0: float = 0.0, u0=Non
     mx = mn = math.nan
     if converged:
         s_c = s.copy()
-        got, t_c, _, _, _ = flow.crossings(s_c, 1)
+        got, t_c, _, _, _ = flow.crossings(s_c, crossings)
         miss = (float(np.linalg.norm(state_u(params.model, s_c) - z)) if got == "ok"
                 else math.inf)
         if not miss <= CONFIRM_TOL * (1.0 + float(np.linalg.norm(z))):
@@ -500,6 +502,7 @@ def limit_cycle(params, section="V", *, x0: float = 0.0, v0: float = 0.0, u0=Non
                 "t": ("t", t, {"long_name": "time from the section point", "units": "s"})},
         attrs=provenance_attrs(params, solver, analysis="limit_cycle", section=text,
                                transient=transient, **start_attrs(u_start), tol=tol,
+                               crossings=crossings,
                                status=status, iterations=it, residual=res,
                                converged=int(converged),
                                verdict=("stable" if stable else "unstable") if converged
@@ -1072,9 +1075,9 @@ def cycle_continuation(params, param: str, section="V", *, k: int = 1, x0: float
     removed by the section), and fold (a multiplier crosses +1, the branch turns), period
     doubling, Neimark-Sacker and grazing points are located on it as for forced orbits.
     Returns the Dataset of :func:`~nonsmooth.continuation` with ``period`` over ``point``
-    and the attr ``section``. ``k`` must be 1 (a cycle that crosses the section several times
-    is followed on a section it crosses once); branch switching (``start``) and section
-    phases are for forced orbits."""
+    and the attr ``section``; ``k``: the cycle's crossings of the section per turn (e.g. 2 for
+    a section counted both ways). Branch switching (``start``) and section phases are for
+    forced orbits."""
     import re
 
     from ..io import components
@@ -1084,10 +1087,6 @@ def cycle_continuation(params, param: str, section="V", *, k: int = 1, x0: float
                                         "continuation")
     param, k, max_points, step, max_step, tol, lo, hi = branch_arguments(
         params, param, k, max_points, step, max_step, tol, direction, bounds)
-    if k != 1:
-        raise ParameterError(f"k: limit cycles are fixed points of the section's one-crossing "
-                             f"return map, got k = {k}: choose a section the cycle crosses "
-                             f"once (k = 1)")
     if param in (params.model.forcing_amplitude, params.model.omega):
         raise ParameterError(f"param: {param} is the forcing's; a branch of a self-excited "
                              f"system follows one of its own parameters")
@@ -1095,7 +1094,8 @@ def cycle_continuation(params, param: str, section="V", *, k: int = 1, x0: float
         raise ParameterError(f"section: {text0!r} names the continued parameter {param}: a "
                              f"branch needs a section that stays put")
     lc = limit_cycle(params, section, x0=x0, v0=v0, u0=u0, transient=transient or 20,
-                     method=method, tol=tol, rtol=rtol, atol=atol, max_time=max_time)
+                     method=method, tol=tol, rtol=rtol, atol=atol, max_time=max_time,
+                     crossings=k)
     lam0 = float(getattr(params, param))
     if lc.attrs["status"] != "converged":
         raise ParameterError(f"start: no limit cycle found on {text} at {param} = {lam0:g} "
