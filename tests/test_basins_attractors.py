@@ -197,3 +197,28 @@ def test_without_the_homeomorphism_property_no_certificate_is_used(monkeypatch):
     np.testing.assert_array_equal(ds.label.values, slow.label.values)
     np.testing.assert_array_equal(ds.periods_used.values, slow.periods_used.values)
     assert (ds.capture_radius.fillna(0).values == 0).all()
+
+
+def test_attractors_that_share_their_x_and_v_are_told_apart_by_the_other_components():
+    """Issue 23, item 2: a forced oscillator (X, V) beside a damped double well Z'' = -0.5 Z'
+    + Z - Z^3 that X and V do not see: two attractors with the same (X, V) section points,
+    Z = +1 and Z = -1. ``basins`` on (Z, W) finds both, and labels each start by the well
+    an independent solution of the double well (scipy) ends in (a grid without the saddle
+    Z = W = 0, where a start would stay)."""
+    from scipy.integrate import solve_ivp
+    m = ns.model_from_equations(
+        "oscillator_and_double_well", states=("X", "V", "Z", "W"),
+        parameters={"F0": 0.5, "omega": 1.0},
+        modes={"free": ["V", "-0.2*V - X + F0*cos(omega*t)", "W", "-0.5*W + Z - Z**3"]},
+        method="smooth", closed_form=False)
+    ds = ns.basins(m.params(), axes=("Z", "W"), x=(-1.5, 1.5), v=(-1.5, 1.5), grid=4,
+                   max_periods=400)
+    assert ds.sizes["attractor"] == 2 and float(ds.undecided_fraction) == 0.0
+    zs = [float(ds.attractor_Z[k, 0]) for k in range(2)]  # each attractor's Z on the section
+    assert sorted(np.round(zs, 6)) == [-1.0, 1.0]
+    assert np.allclose(ds.attractor_X[0].values, ds.attractor_X[1].values, atol=1e-6)
+    for i, z0 in enumerate(ds.x0.values):
+        for j, w0 in enumerate(ds.v0.values):
+            sol = solve_ivp(lambda t, y: [y[1], -0.5 * y[1] + y[0] - y[0]**3], (0, 200),
+                            [z0, w0], rtol=1e-10, atol=1e-12)
+            assert zs[int(ds.label[i, j])] == pytest.approx(np.sign(sol.y[0, -1]), abs=1e-6)

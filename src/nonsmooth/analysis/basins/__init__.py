@@ -116,7 +116,7 @@ from ...io import (apply_state_units, check_memory, flag_attrs, provenance_attrs
                    status_flags)
 from ...kernels import Solver, new_state, output_buffers, run
 from ...models.base import ParamsBase
-from ...simulate import check_float, check_int, check_params
+from ...simulate import check_float, check_int, check_params, state_u
 from ...sweep import parallel_chunks, resolve_workers, threads
 from ..periodicity import section_tolerance
 from ._core import (_HOLD, _K, _N_REC, _Q, _RES, _RES_FAILED, _RES_NEW, _RUNNING, _STATUS,
@@ -398,17 +398,23 @@ def _run_round_points(solver, pk, X0, V0, done_before, n, max_periods, transient
         for i in np.flatnonzero(recs[:, _RES] == _RES_NEW):
             q = int(recs[i, _Q])
             pts = np.stack([cX[i, :q], cV[i, :q]], axis=1)
-            k = found.match(pts)
+            # a model with more than X and V: every component takes part (its state is at
+            # the candidate's last section point)
+            u = state_u(solver.model, states[i]) if base.size else None
+            k = found.match(pts, u)
             if k < 0 and not found.was_rejected(pts):
                 # a model with more than X and V: polish from the trajectory's own state
                 confirmed = _polish(solver, pk, pts, tol, states[i] if base.size else None)
                 if confirmed is None:
                     found.rejected.append(pts)
                 else:
-                    k = found.match(confirmed[0])
+                    full = (_full_points(solver, pk, confirmed[2], len(confirmed[0]))
+                            if base.size else None)
+                    k = found.match(confirmed[0], None if full is None else full[-1])
                     if k < 0:
                         k = found.add(confirmed[0], confirmed[1],
-                                      state=confirmed[2] if len(confirmed) > 2 else None)
+                                      state=confirmed[2] if len(confirmed) > 2 else None,
+                                      full=full)
             if k >= 0:
                 recs[i, _RES] = k
             elif recs[i, _K] < max_periods:
@@ -425,6 +431,15 @@ def _run_round_points(solver, pk, X0, V0, done_before, n, max_periods, transient
     cloud = (done_before + und, bufs[und, 0, :c], bufs[und, 1, :c], states[und])
     recs[recs[:, _RES] == _RES_FAILED, _RES] = LABEL_UNDECIDED
     return recs, cloud
+
+
+def _full_points(solver, pk, state, q):
+    """Every state component at the q section points of a periodic attractor from the kernel
+    ``state`` at its first one (the last row: back at that point); NaN where the run fails."""
+    from ...sweep import run_trajectories
+    res = run_trajectories(pk[None, :], solver, state[None, :], per_period=1, n_skip=0,
+                           n_out=q, workers=1, components=True)
+    return res["U"][0]
 
 
 def _check_axes(model, axes, u0):
@@ -597,6 +612,14 @@ def _dataset(params, solver, xs, vs, label, used, status, found, key, kind, cont
             mean_periods_used=float(used.mean()), samples_per_period=spp,
             forcing_period=params.period, **extra),
     )
+    if any(found.full[k] is not None for k in key):  # more than X and V: every component
+        from ...simulate import component_variables
+        AU = np.full((n_att, npt, params.model.n), np.nan)
+        for new, old in enumerate(key):
+            if found.full[old] is not None:  # its rows start one period on: roll to the first
+                AU[new, :len(found.full[old])] = np.roll(found.full[old], 1, axis=0)
+        ds.update(component_variables(params.model, ("attractor", "n"), AU,
+                                      prefix="attractor_", what=" at the section points"))
     ds = apply_state_units(ds, params.model)
     if base.size:  # the grid's axes are other components: say which, and the fixed rest
         m = params.model

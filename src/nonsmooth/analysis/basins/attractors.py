@@ -52,6 +52,7 @@ class _Attractors:
         self.certified = []
         self.kind = []
         self.states = []  # kernel state at the first section point (None: from X, V alone)
+        self.full = []  # (q, n) every state component at the section points (None: n = 2)
         self.rejected = []  # (q, 2) arrays
 
     def flat(self):
@@ -62,23 +63,30 @@ class _Attractors:
         alab = np.concatenate([np.full(len(pt), k, np.int64) for k, pt in enumerate(self.points)])
         return apts, arad ** 2, alab
 
-    def match(self, pts):
+    def match(self, pts, u=None):
         """Label of the known periodic attractor with the same set of section points (within
         match_tol) whose period is the candidate's or divides it (a slowly converging orbit can
-        pass the periodicity test for a multiple of its period first), or -1."""
+        pass the periodicity test for a multiple of its period first), or -1. With ``u`` (a
+        model with more than X and V: every component at one of the candidate's section
+        points), that state must also be one of the attractor's: two attractors may share
+        their (X, V)."""
         for k, a in enumerate(self.points):
             if self.kind[k] == KIND_PERIODIC and _same_orbit(pts, a, self.match_tol):
-                return k
+                f = self.full[k]
+                if u is None or f is None or np.abs(f - u).max(axis=1).min() <= self.match_tol:
+                    return k
         return -1
 
     def was_rejected(self, pts):
         return any(_same_orbit(pts, a, self.match_tol) for a in self.rejected)
 
-    def add(self, pts, extremes, kind=KIND_PERIODIC, state=None):
+    def add(self, pts, extremes, kind=KIND_PERIODIC, state=None, full=None):
         """A new attractor with section points ``pts`` and ``extremes`` = (max X, min X,
-        visited-mode mask) over the periods followed (and the kernel ``state`` at its first
-        section point, for a model with more than X and V); returns its label."""
+        visited-mode mask) over the periods followed (and, for a model with more than X and V,
+        the kernel ``state`` at its first section point and ``full``, every component at each
+        section point); returns its label."""
         self.states.append(None if state is None else np.array(state, dtype=np.float64))
+        self.full.append(None if full is None else np.array(full, dtype=np.float64))
         self.points.append(np.array(pts, dtype=np.float64))
         self.max_x.append(float(extremes[0]))
         self.min_x.append(float(extremes[1]))
