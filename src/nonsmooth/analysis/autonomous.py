@@ -128,6 +128,8 @@ class _Flow:
         self.p = params.pack()
         self.H = H
         self.a = H[:self.model.n]
+        # an orthonormal basis (n x (n - 1)) of the section hyperplane's directions
+        self.basis = np.linalg.svd(self.a[None, :])[2][1:].T
         self.direction = direction
         self.T = params.period
         self.budget = max(1, int(math.ceil(max_time / self.T)))
@@ -417,9 +419,7 @@ def limit_cycle(params, section="V", *, x0: float = 0.0, v0: float = 0.0, u0=Non
     n = params.model.n
     u_start, s = _start(params, solver, x0, v0, u0)
     status, _, _, _, _ = flow.crossings(s, transient)
-    a = flow.a
-    # an orthonormal basis B of the section's directions (the null space of a^T)
-    B = np.linalg.svd(a[None, :])[2][1:].T
+    B = flow.basis
     from ..simulate import state_u
     res, it, period, J = math.inf, 0, math.nan, None
     if status == "ok":
@@ -943,7 +943,7 @@ class _CycleBranch:
 
     def __init__(self, params, param, solver, flow, z_ref, template, k, tol, level):
         self.params0, self.param, self.solver, self.flow = params, param, solver, flow
-        self.B = np.linalg.svd(flow.a[None, :])[2][1:].T
+        self.B = flow.basis
         self.z_ref, self.template, self.k, self.tol, self.level = z_ref, template, k, tol, level
         self.N = params.model.n - 1
 
@@ -997,6 +997,7 @@ class _CycleBranch:
         iterations) or None. The corrected point must lie within one step (|y_pred - base|,
         ``base`` the corrected point the prediction steps from) of its prediction: past a fold,
         Newton may otherwise land on an equilibrium on the section, a fixed point of the map."""
+        from .continuation import _accepted
         y = y_pred.copy()
         N = self.N
         reach = np.linalg.norm(y_pred - base) + 1e3 * self.tol * (1.0 + np.linalg.norm(y))
@@ -1018,11 +1019,7 @@ class _CycleBranch:
             z = self.z(y[:N])
             if (np.linalg.norm(F) <= self.tol * (1.0 + np.linalg.norm(z))
                     and np.linalg.norm(d) <= 1e3 * self.tol * (1.0 + np.linalg.norm(y))):
-                ev = self.evaluate(y[:N], y[N])
-                if ev is None:
-                    return None
-                self.template = ev[3]
-                return y, ev, it
+                return _accepted(self, y, it)
         return None
 
     def tangent(self, ev, t_prev):
@@ -1126,6 +1123,5 @@ def cycle_continuation(params, param: str, section="V", *, k: int = 1, x0: float
                     {"long_name": "period of the limit cycle", "units": "s"})
     for c in ("X_section", "V_section"):
         ds[c].attrs["long_name"] = (f"{c[0]} where the cycle crosses the section")
-    ds.attrs.update(section=text, cycle_crossings=k)
-    ds.attrs["k"] = k
+    ds.attrs.update(section=text, k=k)
     return ds

@@ -53,6 +53,17 @@ MIN_STEP = 1.0 / 4096  # smallest arclength step, relative to ``step``
 _SAMPLES = 100  # samples per period of the orbit for max/min X and the contact fraction
 
 
+def _accepted(br, y, it):
+    """A converged corrector's point y (after ``it`` iterations) of branch ``br``, evaluated
+    once more: (y, evaluation, it), its start state the next corrections' template; None if
+    the evaluation fails."""
+    ev = br.evaluate(y[:br.N], y[br.N])
+    if ev is None:
+        return None
+    br.template = ev[3]
+    return y, ev, it
+
+
 class _Branch:
     """The map, its derivatives and the corrector at one parameter index."""
 
@@ -114,11 +125,7 @@ class _Branch:
             y[ina] += F[ina]  # memory rewritten before it is read: its mapped value
             small = np.linalg.norm(F[ia]) <= self.tol * (1.0 + np.linalg.norm(y[:N]))
             if small and np.linalg.norm(d) <= 1e3 * self.tol * (1.0 + np.linalg.norm(y)):
-                ev = self.evaluate(y[:N], y[N])
-                if ev is None:
-                    return None
-                self.template = ev[3]
-                return y, ev, it
+                return _accepted(self, y, it)
         return None
 
     def jacobian(self, ev):

@@ -213,8 +213,7 @@ def plot_continuation(ds, var: str = "max_X", ax=None):
     ax.legend(loc="best", fontsize=8)
     a = ds.attrs
     k = int(a.get("k", 1))
-    what = (f"limit cycles on {a['section']}" if "section" in a and "cycle_crossings" in a
-            else f"period-{k} orbits")
+    what = f"limit cycles on {a['section']}" if "section" in a else f"period-{k} orbits"
     ax.set_title(f"continuation of the {what} in {param}: {lam.size} points, "
                  f"{nsp} special, {a.get('status', '?')}\n{a.get('method', '')}: "
                  f"{param_title(ds, exclude=(param,))}", fontsize=9)
