@@ -62,9 +62,9 @@ CASES = (
     ("stick_slip", lambda m: m.params(omega=0.95),
      "defaults, omega = 0.95: stick-slip cycle, Coulomb slip in closed form"),
     ("bouncing_ball", lambda m: m.preset("period_one"),
-     "Gamma = 1.3: the period-one orbit, one impact per period (free flight: RKF45)"),
+     "Gamma = 1.3: the period-one orbit, one impact per period (free flight in closed form)"),
     ("impact_2dof", lambda m: m.params(),
-     "defaults: one impact per period, four states (RKF45 between impacts)"),
+     "defaults: one impact per period, four states (closed form between impacts)"),
     ("jeffcott_rotor", lambda m: m.preset("partial_rub"),
      "partial_rub: two crossings of the clearance circle per turn (a curved guard), four "
      "states"),

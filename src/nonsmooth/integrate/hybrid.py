@@ -91,8 +91,8 @@ from .pwlinear import (BD_D2, BD_D3, BD_D4, BD_R, EXCLUDED, HERM_ERR, MC_A,  # n
                        energy_norm, eval_state, functional_bounds, herm_clear, herm_coeffs,
                        hom_part, jerk, mode_coeffs, propagator)
 from .linmodes import (N_TAYLOR, POLY_DEPTH, THETA_POLY, guard_poly, lin_matrix,  # noqa: E402
-                       poly_component, poly_m4, poly_state, poly_tangent, poly_x_extrema, pval,
-                       taylor_terms)
+                       poly_component, poly_m4, poly_root, poly_state, poly_tangent,
+                       poly_x_extrema, pval, taylor_terms)
 from .record import record_interval  # noqa: E402
 from .roots import illinois_point, illinois_update, quad_roots01  # noqa: E402
 from .rkstep import (_A, _B, _C, _E, _FM, _NS, _control, _cubic, _shrink,  # noqa: E402
@@ -488,7 +488,7 @@ def _immediate_exit_curved(curved, mode, tau, G, ng, n, u, f0, C, S, om, pp, mem
     return -1
 
 
-@nb.njit(cache=True)
+@nb.njit(cache=True, inline="always")
 def _g_eval(kind, s, cp, curved, mode, k, tau, C, S, hs, om, n, u, f0, u1, f1, pp, mem, gr, us,
             pm, TW):
     """(g, dg/dt) of guard k at the fraction s of the step: kind 0, an affine guard on a
@@ -604,6 +604,8 @@ def _guard_exit(kind, cp, curved, mode, k, tau, C, S, hs, om, n, u, f0, u1, f1, 
             return 2.0, 2.0
         glo = _g_eval(kind, lo, cp, curved, mode, k, tau, C, S, hs, om, n, u, f0, u1, f1, pp,
                       mem, gr, us, pm, TW)[0] if lo > 0.0 else g0
+        if kind == 0:  # a polynomial: Newton, its derivative is free
+            lo, hi = poly_root(cp, hs, lo, hi, glo, ghi, S_TOL)
         side = 0
         for _ in range(200):
             if hi - lo <= S_TOL:
@@ -1369,7 +1371,7 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
                     xmax, xmin = _x_extrema_exact(MC, mode, om, y0, z0, C, S, u[0], u[1], u1[0],
                                                   u1[1], hs, xmax, xmin)
                 elif pm:
-                    xmax, xmin = poly_x_extrema(TW, hs, xmax, xmin)
+                    xmax, xmin = poly_x_extrema(TW, hs, xmax, xmin, cp)
                 else:
                     xmax, xmin = _x_extrema(u[0], f0[0], u1[0], f1[0], hs, xmax, xmin)
                 for i in range(n):

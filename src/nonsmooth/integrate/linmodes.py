@@ -27,7 +27,6 @@ import math
 import numba as nb
 import numpy as np
 
-from .roots import illinois_point, illinois_update
 
 THETA_POLY = 2.0  # rho L on a full piece
 N_TAYLOR = 28  # terms beyond the constant one
@@ -152,10 +151,11 @@ def poly_m4(c, b):
 
 
 @nb.njit(cache=True)
-def poly_x_extrema(TW, hs, xmax, xmin):
+def poly_x_extrema(TW, hs, xmax, xmin, cv):
     """(xmax, xmin) with the interior extrema of X = z[0] on the piece [0, hs]: where
     V = z[0]' changes sign between X_SAMPLES + 1 points (a piece spans THETA_POLY = 2 of the
-    fastest rate: at most one sign change is expected between two of them)."""
+    fastest rate: at most one sign change is expected between two of them), located by
+    ``poly_root`` on V (``cv``: work, N_TAYLOR + 1)."""
     va = poly_component(TW, 0, 0.0)[1]
     for q in range(1, X_SAMPLES + 1):  # V at X_SAMPLES points: each sign change an extremum
         a = (q - 1) * hs / X_SAMPLES
@@ -163,15 +163,11 @@ def poly_x_extrema(TW, hs, xmax, xmin):
         vb = poly_component(TW, 0, b)[1]
         if va * vb < 0.0:
             sg = 1.0 if va >= 0.0 else -1.0  # g = sg V >= 0 at the lower end
-            lo, hi, glo, ghi = a, b, sg * va, sg * vb
-            side = 0
-            for _ in range(100):
-                if hi - lo <= 1e-15 * hs:
-                    break
-                sm = illinois_point(lo, hi, glo, ghi)
-                gm = sg * poly_component(TW, 0, sm)[1]
-                lo, hi, glo, ghi, side = illinois_update(lo, hi, glo, ghi, side, sm, gm)
-            x = poly_component(TW, 0, 0.5 * (lo + hi))[0]
+            for j in range(N_TAYLOR):
+                cv[j] = sg * (j + 1) * TW[j + 1, 0]
+            cv[N_TAYLOR] = 0.0
+            lo, hi = poly_root(cv, hs, a / hs, b / hs, sg * va, sg * vb, 1e-15)
+            x = poly_component(TW, 0, 0.5 * (lo + hi) * hs)[0]
             xmax = max(xmax, x)
             xmin = min(xmin, x)
         va = vb
@@ -196,3 +192,62 @@ def poly_tangent(Mx, n, h, Y, t0, t1):
             for i in range(n):
                 t0[i] = t1[i]
                 Y[i, col] += t1[i]
+
+
+@nb.njit(cache=True)
+def poly_root(c, hs, lo, hi, glo, ghi, tol):
+    """The bracket [lo, hi] (fractions of the piece of length hs; p(lo hs) = glo >= 0 >
+    ghi = p(hi hs)) of a root of the polynomial c, shrunk to ``tol``. Newton on p (its
+    derivative comes with its value), started at the root of the cubic Hermite of (p, p') at
+    the bracket's ends and kept inside the bracket; a step that leaves it or does not halve
+    the previous one is replaced by the bracket's midpoint. Converged, an iterate steps tol / 2
+    past the root so that the bracket closes from both sides. (Illinois bisects while
+    p(lo) = 0, as after a reset onto the guard's surface: some 20 steps more for a flight of
+    1e-6 of the piece.) Returns (lo, hi)."""
+    L = (hi - lo) * hs
+    dlo = pval(c, lo * hs)[1] * L
+    dhi = pval(c, hi * hs)[1] * L
+    # the Hermite H(u) = glo + a1 u + a2 u^2 + a3 u^3 on [0, 1]: its root in the bracket
+    dg = ghi - glo
+    a1 = dlo
+    a2 = 3.0 * dg - 2.0 * dlo - dhi
+    a3 = -2.0 * dg + dlo + dhi
+    ul = 0.0
+    uh = 1.0
+    u = glo / (glo - ghi)
+    for _ in range(60):
+        h = glo + u * (a1 + u * (a2 + u * a3))
+        if h < 0.0:
+            uh = u
+        else:
+            ul = u
+        hp = a1 + u * (2.0 * a2 + 3.0 * u * a3)
+        un = u - h / hp if hp != 0.0 else -1.0
+        if not ul < un < uh:
+            un = 0.5 * (ul + uh)
+        done = abs(un - u) <= 1e-3 * tol
+        u = un
+        if done or uh - ul <= 1e-3 * tol:
+            break
+    x = lo + u * (hi - lo)
+    if not lo < x < hi:
+        x = 0.5 * (lo + hi)
+    dx_old = math.inf
+    for _ in range(200):
+        g, d = pval(c, x * hs)
+        if g < 0.0:
+            hi = x
+        else:
+            lo = x
+        if hi - lo <= tol:
+            break
+        dx = -g / (d * hs) if d != 0.0 else math.inf
+        if abs(dx) < 0.25 * tol:  # converged: step past the root, to close the bracket
+            dx = 0.5 * tol if dx >= 0.0 else -0.5 * tol
+        xn = x + dx
+        if not (lo < xn < hi and abs(dx) <= 0.5 * dx_old):
+            xn = 0.5 * (lo + hi)
+            dx = xn - x
+        dx_old = abs(dx)
+        x = xn
+    return lo, hi
