@@ -160,6 +160,67 @@ def test_periodic_forcing_in_t_is_the_same_at_any_section_phase():
     assert np.max(np.abs(b.X.values - a.X.values[1:1 + b.sizes["t"]])) < 1e-8
 
 
+def square_wave(method="exact"):
+    """A linear oscillator pushed by a square wave of period T (a parameter): +F0 while
+    sin(2 pi t / T) >= 0, -F0 after; two modes whose surfaces are affine in sin, so the
+    switches are located exactly and each mode is a closed-form linear mode."""
+    return ns.model_from_equations(
+        "square_wave", states=("X", "V"),
+        parameters={"xi": 0.05, "F0": 0.4, "T": dict(default=5.0, low=0.0, low_open=True)},
+        modes={"push": ["V", "-X - xi*V + F0"], "pull": ["V", "-X - xi*V - F0"]},
+        guards={"push": [("sin(2*pi*t/T)", "pull")], "pull": [("-sin(2*pi*t/T)", "push")]},
+        initial=[("sin(2*pi*t/T) >= 0", "push")], period="T", method=method,
+        forcing_amplitude="F0")
+
+
+def test_a_model_names_its_forcing_period():
+    """``period="T"``: T frames time (the section at t = kT, the output interval, t in the
+    functions); a square wave switched exactly at its edges matches scipy integrating each
+    half period, and the stroboscopic analyses sweep T."""
+    m = square_wave()
+    assert m.forcing_param == "T" and not m.autonomous and m.omega is None
+    assert m.methods["exact"].closed_form
+    p = m.params(T=5.0)
+    assert p.period == 5.0 and p.pack().size == len(m.parameters)
+    ds = ns.simulate(p, periods=6, method="exact", samples_per_period=4)
+    np.testing.assert_allclose(np.diff(ds.t.values), 5.0 / 4)
+
+    def half(sign):
+        return lambda t, y: [y[1], -y[0] - 0.05 * y[1] + sign * 0.4]
+    y, ref = np.zeros(2), [0.0]
+    for k in range(12):  # half periods: push, pull, ...
+        for q in (1, 2):  # output at T/4 within each half period, and at its end
+            sol = solve_ivp(half(1 if k % 2 == 0 else -1), (0, 1.25), y, rtol=1e-12,
+                            atol=1e-14, method="DOP853")
+            y = sol.y[:, -1]
+            ref.append(y[0])
+    np.testing.assert_allclose(ds.X.values, ref, atol=1e-9)
+    # the same forcing period as a frequency: omega = 2 pi / T gives the same numbers
+    mw = ns.model_from_equations(
+        "square_wave_omega", states=("X", "V"),
+        parameters={"xi": 0.05, "F0": 0.4, "omega": 2 * math.pi / 5.0},
+        modes={"push": ["V", "-X - xi*V + F0"], "pull": ["V", "-X - xi*V - F0"]},
+        guards={"push": [("sin(omega*t)", "pull")], "pull": [("-sin(omega*t)", "push")]},
+        initial=[("sin(omega*t) >= 0", "push")], method="exact")
+    dw = ns.simulate(mw.params(), periods=6, method="exact", samples_per_period=4)
+    np.testing.assert_allclose(dw.X.values, ds.X.values, atol=1e-12)
+    # stroboscopic analyses sweep the period: a linear system has one period-1 orbit
+    bd = ns.bifurcation_diagram(p, "T", np.linspace(4.0, 6.0, 3), transient=300, record=8,
+                                method="exact", sweep="up", lyapunov=False)
+    assert bd.T.values.tolist() == [4.0, 5.0, 6.0]
+    assert (bd.period.values == 1).all()
+    po = ns.periodic_orbit(p, method="exact")
+    assert int(po.converged) == 1
+    # the damped linear map: both multipliers have modulus exp(-xi T / 2)
+    np.testing.assert_allclose(po.multiplier_abs.values, math.exp(-0.05 * 5.0 / 2), rtol=1e-8)
+    with pytest.raises(ParameterError, match="period 'P' must be a parameter"):
+        ns.model_from_equations("bad", states=("X", "V"), parameters={"T": 1.0},
+                                modes={"free": ["V", "-X"]}, period="P")
+    with pytest.raises(ParameterError, match="not both"):
+        ns.model_from_equations("bad", states=("X", "V"), parameters={"T": 1.0, "w": 1.0},
+                                modes={"free": ["V", "-X"]}, period="T", omega="w")
+
+
 @pytest.mark.parametrize("change, needle", [
     (dict(modes={"free": ["V", "-X + foo"]}), "mode free, dV/dt: unknown name 'foo'"),
     (dict(modes={"free": ["V", "-X +* 2"]}), "mode free, dV/dt: cannot parse"),

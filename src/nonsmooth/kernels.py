@@ -31,6 +31,7 @@ from .integrate.contract import (
     OPT_MAX_STEPS,
     OPT_N,
     OPT_NMEM,
+    OPT_FRAME_PERIOD,
     OPT_OMEGA,
     OPT_PHASE,
     OPT_RTOL,
@@ -40,7 +41,7 @@ from .integrate.contract import (
     ST_V,
     ST_X,
 )
-from .integrate.hybrid import advance_generic
+from .integrate.hybrid import advance_generic, frame_omega
 from .models.base import DEFAULT_MODEL, KERNEL_GENERIC, KERNEL_SUPPORT_EXACT, KERNEL_SUPPORT_SMOOTH
 from .models.support.exact_kernel import advance_exact
 from .models.support.smooth_kernel import advance_smooth
@@ -102,7 +103,7 @@ def mode_holds(kernel, fns, p, opts, state):
     grad = np.empty(n + 1)
     for k in range(ng):
         if math.isnan(G[k, n]):  # a curved guard (``curved_row``)
-            g = fns[6](mode, k, psi / pp[int(opts[OPT_OMEGA])], c, s, u, pp, mem, grad)
+            g = fns[6](mode, k, psi / frame_omega(pp, opts), c, s, u, pp, mem, grad)
         else:
             g = G[k, n] + G[k, n + 1] * c + G[k, n + 2] * s
             for i in range(n):
@@ -188,6 +189,7 @@ class Solver:
         o[OPT_MAX_STEPS] = self.max_steps
         o[OPT_VARIANT] = m.variant
         o[OPT_OMEGA] = self.model.frame_index
+        o[OPT_FRAME_PERIOD] = 1.0 if self.model.period is not None else 0.0
         o[OPT_N] = self.model.n
         o[OPT_NMEM] = self.model.n_memory
         o[OPT_CLOSED_FORM] = 1.0 if m.closed_form else 0.0

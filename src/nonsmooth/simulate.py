@@ -274,7 +274,8 @@ def simulate(params: ParamsBase, *, periods: int, transient: int = 0,
     U = np.concatenate([state_u(params.model, state)[None, :], rec["U"][0]])
     T = params.period
     w = params.model.omega
-    t0 = transient * T + solver.section_phase / (getattr(params, w) if w else 1.0)
+    t0 = transient * T + (solver.section_phase / getattr(params, w) if w
+                          else solver.section_phase * T / (2.0 * np.pi))
     t = t0 + np.arange(n + 1) * (T / spp)
     modes = params.model.mode_names
     regions = flag_attrs(modes, dtype=np.int8)

@@ -1084,7 +1084,7 @@ def cycle_continuation(params, param: str, section="V", *, k: int = 1, x0: float
                                         "continuation")
     param, k, max_points, step, max_step, tol, lo, hi = branch_arguments(
         params, param, k, max_points, step, max_step, tol, direction, bounds)
-    if param in (params.model.forcing_amplitude, params.model.omega):
+    if param in (params.model.forcing_amplitude, params.model.forcing_param):
         raise ParameterError(f"param: {param} is the forcing's; a branch of a self-excited "
                              f"system follows one of its own parameters")
     if isinstance(text0, str) and param in re.findall(r"[A-Za-z_]\w*", text0):

@@ -64,7 +64,8 @@ def _continue_to(params, solver, starts, target, states, transient, record, sett
     for b, w in enumerate(starts):
         path = np.linspace(w, target, nstep + 1)[1:]
         path[-1] = target
-        P[b] = np.stack([params.replace(**{params.model.omega: float(x)}).pack() for x in path])
+        P[b] = np.stack([params.replace(**{params.model.forcing_param: float(x)}).pack()
+                         for x in path])
     states = np.array(states, dtype=np.float64, copy=True)
     out = follow(P, solver, states, states[0].copy(), transient, settle_tol, record,
                  workers=workers)
@@ -202,7 +203,7 @@ def resonance_curve(params: ParamsBase, omegas, *, method: str = "smooth", trans
     transient = check_int("transient", transient, 0)
     record = check_int("record", record, 1)
     check_sweep_memory(np.size(omegas), 2, record)
-    w_name = params.model.omega  # the forcing frequency (support: omega)
+    w_name = params.model.forcing_param  # the forcing frequency (support: omega) or period
     omegas = check_values(w_name, omegas)
     for w in (omegas[0], omegas[-1]):
         params.replace(**{w_name: float(w)})

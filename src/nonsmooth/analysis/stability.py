@@ -477,7 +477,7 @@ def lambda1_points(P, solver, states, periods: int, *, blocks: int = 10, workers
         S[:, ST_MODE] = -1.0
         S[:, ST_H] = 0.0
     n = P.shape[0]
-    om = P[:, solver.model.frame_index]
+    om = solver.model.frequency(P)
     T = 2.0 * np.pi / om
     Ys = np.zeros((n, setup.N))
     Ys[:, :2] = 1.0
@@ -547,7 +547,7 @@ def floquet_lambda1_points(P, solver, states, period, *, workers=None):
     with threads(workers), deferred_interrupts():
         _monodromy_many(setup.fns, P, setup.opts, S, k, setup.N, setup.cmi, mono, status)
     lam = np.full(n, np.nan)
-    om = P[:, solver.model.frame_index]
+    om = solver.model.frequency(P)
     T = 2.0 * np.pi / om
     ok = status == st.OK
     groups = {}

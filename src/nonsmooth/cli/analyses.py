@@ -153,7 +153,7 @@ def bifurcation_cmd(
     preset = preset_label(params, preset, "table3")
     from ..simulate import check_forced
     check_forced(params, "bifurcation")
-    param = params.model.param(param or params.model.omega).name
+    param = params.model.param(param or params.model.forcing_param).name
     if sweep not in SWEEPS:
         raise ParameterError(f"sweep: unknown sweep {sweep!r} (known: {', '.join(SWEEPS)})")
     values = value_range(from_, to, steps, f"{param} range", 2 if sweep == "both" else 1,
@@ -214,7 +214,7 @@ def resonance_cmd(
     preset = preset_label(params, preset, "fig6a")
     from ..simulate import check_forced
     check_forced(params, "resonance")
-    w = params.model.omega  # the model's forcing frequency
+    w = params.model.forcing_param  # the model's forcing frequency (or period)
     omegas = value_range(from_, to, steps, f"{w} range", 2, max(record, 0))
     for v in (omegas[0], omegas[-1]):
         params.replace(**{w: float(v)})

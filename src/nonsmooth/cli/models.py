@@ -25,9 +25,10 @@ def model_lines(name: str) -> list[str]:
     for p in m.parameters:
         out.append(f"  {p.name:{w}s}  default {_value(p.default):>9s}  {p.range_text:28s}  "
                    f"{'[' + p.units + ']':9s}  {p.long_name}")
-    out.append(f"  forcing frequency: {m.omega}" + (f", amplitude: {m.forcing_amplitude}"
-                                                    if m.forcing_amplitude else "")
-               if m.omega else "  no forcing (self-excited; time unit 2 pi)")
+    amp = f", amplitude: {m.forcing_amplitude}" if m.forcing_amplitude else ""
+    out.append(f"  forcing frequency: {m.omega}{amp}" if m.omega else
+               f"  forcing period: {m.period}{amp}" if m.period else
+               "  no forcing (self-excited; time unit 2 pi)")
     state = ", ".join(f"{s} ({ln})" if ln else s for s, ln in
                       zip(m.state_names, tuple(m.state_long_names) + ("",) * m.n))
     out += ["", f"state: {state}",

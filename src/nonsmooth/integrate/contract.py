@@ -32,7 +32,8 @@ OPT_N = 5  # state dimension n >= 2 (generic kernel)
 OPT_NMEM = 6  # number of discrete memory slots (generic kernel)
 OPT_CLOSED_FORM = 7  # 1: propagate the modes a model declares linear in closed form (generic)
 OPT_PHASE = 8  # forcing phase psi = omega t_s of the section (generic): periods start at t_s
-N_OPTS = 9
+OPT_FRAME_PERIOD = 9  # 1: p[opts[OPT_OMEGA]] is the forcing period T, omega = 2 pi / T
+N_OPTS = 10
 
 # state layout
 ST_X = 0

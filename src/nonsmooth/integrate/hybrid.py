@@ -73,6 +73,7 @@ from .contract import (  # noqa: E402
     N_STATE,
     OPT_ATOL,
     OPT_CLOSED_FORM,
+    OPT_FRAME_PERIOD,
     OPT_MAX_STEPS,
     OPT_N,
     OPT_NMEM,
@@ -360,6 +361,14 @@ def _locate(cf, lo, hi, glo, ghi, G, k, n, q0, q1, q2, q3, C, S, om, hs, MC, mod
         gm = _g_at(cf, sm, G, k, n, q0, q1, q2, q3, C, S, om, hs, MC, mode, y0, z0)
         lo, hi, glo, ghi, side = illinois_update(lo, hi, glo, ghi, side, sm, gm)
     return lo, hi
+
+@nb.njit(cache=True, inline="always")
+def frame_omega(pp, opts):
+    """The frequency omega that frames time: p[opts[OPT_OMEGA]], or 2 pi / T where that slot
+    holds the forcing period T (``opts[OPT_FRAME_PERIOD]``, a model's ``period``)."""
+    f = pp[int(opts[OPT_OMEGA])]
+    return 2.0 * math.pi / f if opts[OPT_FRAME_PERIOD] == 1.0 else f
+
 
 @nb.njit(cache=True)
 def _mode_class(linear, closed, mode, pp, lin, MC, mcs, om, MF, n, MX, MXR):
@@ -1047,7 +1056,7 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
     Y = unowned(Y)  # owned by the caller for the whole call
     L_out = unowned(L_out)
     cmi = unowned(cmi)
-    om = pp[int(opts[OPT_OMEGA])]
+    om = frame_omega(pp, opts)
     if not (om > 0.0 and math.isfinite(om)):
         return st.NON_FINITE
     rtol = opts[OPT_RTOL]

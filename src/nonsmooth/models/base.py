@@ -12,7 +12,11 @@ signatures of :mod:`nonsmooth.integrate.contract`). It declares
   T = 2 pi / omega frames time (output intervals, the stroboscopic section at t = t_s + kT, and
   the local time that restarts at t_s every period; t_s = section_phase / omega, 0 by
   default, so t runs over [t_s, t_s + T)). Functions receive t and (c, s) = (cos omega t,
-  sin omega t), so they never evaluate a cosine. A self-excited system may declare no forcing
+  sin omega t), so they never evaluate a cosine. A forcing of any other periodic form names
+  its **period** instead (``omega=None, period="T"``, a parameter): T frames time as above,
+  (c, s) = (cos 2 pi t / T, sin 2 pi t / T), and the functions compute the forcing from t in
+  [t_s, t_s + T) (several harmonics, a pulse train: modes whose guards are affine in c and s
+  switch exactly where a pulse starts and ends). A self-excited system may declare no forcing
   (``omega=None``): its time unit is then 2 pi (c, s are cos t, sin t and mean nothing), the
   stroboscopic analyses refuse it in one line, and it is studied on section surfaces
   (``limit_cycle``, ``surface_basins``, ``equilibria``, see :mod:`nonsmooth.analysis.autonomous`);
@@ -202,18 +206,22 @@ class ModelParams(ParamsBase):
 
     def pack(self) -> np.ndarray:
         """The values in the order of ``model.param_names``; a model without forcing
-        (``omega=None``) gets one more slot, its time unit's frequency 1 (``frame_index``)."""
+        gets one more slot, its time unit's frequency 1 (``frame_index``)."""
         vals = [self._values[n] for n in self.model.param_names]
-        if self.model.omega is None:
+        if self.model.autonomous:
             vals.append(1.0)
         return np.array(vals, dtype=np.float64)
 
     @property
     def period(self) -> float:
-        """Forcing period T = 2 pi / omega (a model without forcing: its time unit 2 pi)."""
-        if self.model.omega is None:
+        """Forcing period T = 2 pi / omega, or the value of the model's ``period`` parameter
+        (a model without forcing: its time unit 2 pi)."""
+        m = self.model
+        if m.period is not None:
+            return float(self._values[m.period])
+        if m.omega is None:
             return 2.0 * math.pi
-        return 2.0 * math.pi / self._values[self.model.omega]
+        return 2.0 * math.pi / self._values[m.omega]
 
     def attrs(self) -> dict:
         """Flat netCDF attributes: ``model`` and ``param_<name>``."""
@@ -280,6 +288,7 @@ class Model:
     mode_names: tuple
     methods: dict
     omega: str | None = "omega"
+    period: str | None = None
     forcing_amplitude: str | None = "F0"
     n_memory: int = 0
     state_units: tuple = ()
@@ -304,7 +313,13 @@ class Model:
         names = [p.name for p in self.parameters]
         if len(set(names)) != len(names):
             raise bad("parameter names must be unique")
-        if self.omega is None:
+        if self.period is not None:
+            if self.omega is not None:
+                raise bad("a forcing has a frequency (omega) or a period (period), not both: "
+                          "give omega=None with period")
+            if self.period not in names:
+                raise bad(f"the forcing period {self.period!r} must be a parameter")
+        elif self.omega is None:
             if self.forcing_amplitude is not None:
                 raise bad("a model without forcing (omega=None) has no forcing_amplitude")
         elif self.omega not in names:
@@ -337,15 +352,28 @@ class Model:
 
     @property
     def frame_index(self) -> int:
-        """Where the kernels read the frequency that frames time (T = 2 pi / omega): the
-        forcing frequency's slot, or for a model without forcing the extra slot that
-        ``pack`` appends (1: a time unit of 2 pi)."""
+        """Where the kernels read what frames time: the forcing frequency's slot (T = 2 pi /
+        omega), the forcing period's (``period``: T itself), or for a model without forcing
+        the extra slot that ``pack`` appends (frequency 1: a time unit of 2 pi)."""
+        if self.period is not None:
+            return self.index[self.period]
         return len(self.parameters) if self.omega is None else self.index[self.omega]
 
     @property
+    def forcing_param(self) -> str | None:
+        """The parameter that sets the forcing's period: ``omega`` (a frequency) or
+        ``period``; None without forcing."""
+        return self.period if self.period is not None else self.omega
+
+    def frequency(self, P):
+        """omega = 2 pi / T of packed parameter rows ``P`` (the last axis: parameters)."""
+        f = np.asarray(P, dtype=np.float64)[..., self.frame_index]
+        return 2.0 * math.pi / f if self.period is not None else f
+
+    @property
     def autonomous(self) -> bool:
-        """True for a model that declares no forcing (``omega=None``)."""
-        return self.omega is None
+        """True for a model that declares no forcing (``omega=None`` and no ``period``)."""
+        return self.omega is None and self.period is None
 
     @property
     def index(self) -> dict:
@@ -588,7 +616,7 @@ def _check_curved(model, m, fns, mode, k, p, u, mem, bad, call_curved):
         raise bad(f"guards marks surface {k} of mode {name} curved, but the method has no "
                   "curved function")
     n = model.n
-    om = float(p[model.frame_index])
+    om = float(model.frequency(p))
 
     def g_at(t, uu):
         grad = np.zeros(n + 1)

@@ -86,8 +86,8 @@ class Guard:
 
 def model_from_equations(name: str, *, states, parameters, modes: dict | None = None,
                          guards: dict | None = None, initial=None, method: str = "exact",
-                         methods: dict | None = None, omega: str = "omega",
-                         forcing_amplitude: str | None = None, description: str = "",
+                         methods: dict | None = None, omega: str | None = "omega",
+                         period: str | None = None, forcing_amplitude: str | None = None, description: str = "",
                          flow_is_homeomorphism: bool = False, closed_form: bool = True,
                          rtol: float | None = None, atol: float | None = None,
                          admissible=None, contact_modes=(), **model_kw) -> Model:
@@ -110,7 +110,9 @@ def model_from_equations(name: str, *, states, parameters, modes: dict | None = 
     ``guards``, ``initial`` and ``method``; the model's modes are those of all methods, in
     order of appearance (a mode of the same name is one mode). ``omega``: the forcing
     frequency parameter (None: a self-excited system without forcing, whose equations do not
-    use t; see ``Model.omega``). ``contact_modes``: mode names that count as contact. Other keywords
+    use t; see ``Model.omega``). ``period``: instead of ``omega``, the parameter that is the
+    forcing's period T (a forcing of any periodic form written in t; ``cos(2*pi*t/T)`` and
+    ``sin(2*pi*t/T)`` are the fast harmonic terms). ``contact_modes``: mode names that count as contact. Other keywords
     (``state_units``, ``state_long_names``, ``presets``, ``contact_name``, ``lines``,
     ``references``, ``check``, ...) go to :class:`Model` as they are.
 
@@ -143,7 +145,13 @@ def model_from_equations(name: str, *, states, parameters, modes: dict | None = 
             raise bad(f"{nm!r} cannot name a state or parameter (reserved or not an identifier)")
     if len(set(states + pnames)) != len(states) + len(pnames):
         raise bad("state and parameter names must all differ")
-    if omega is not None and omega not in pnames:
+    if period is not None:
+        if omega not in (None, "omega"):
+            raise bad("a forcing has a frequency (omega) or a period (period), not both")
+        omega = None
+        if period not in pnames:
+            raise bad(f"the forcing period {period!r} must be a parameter")
+    elif omega is not None and omega not in pnames:
         raise bad(f"the forcing frequency {omega!r} must be a parameter")
     mode_names = tuple(dict.fromkeys(m for spec in methods.values()
                                      for m in (spec.get("modes") or {})))
@@ -152,8 +160,9 @@ def model_from_equations(name: str, *, states, parameters, modes: dict | None = 
     sym = {nm: sp.Symbol(nm, real=True) for nm in states + pnames}
     t = sp.Symbol("t", real=True)
     C, S = sp.Dummy("cos_omega_t", real=True), sp.Dummy("sin_omega_t", real=True)
-    ctx = _Context(sp, sym, t, C, S, sym[omega] if omega is not None else None, set(states),
-                   name)
+    w = sym[omega] if omega is not None else 2 * sp.pi / sym[period] if period else None
+    ctx = _Context(sp, sym, t, C, S, w, set(states), name)
+    ctx.period = period
     built = {}
     for mname, spec in methods.items():
         unknown = set(spec) - {"modes", "guards", "initial", "rtol", "atol", "description",
@@ -166,7 +175,7 @@ def model_from_equations(name: str, *, states, parameters, modes: dict | None = 
         contact_modes = sum(1 << _mode_index(m, mode_names, bad) for m in contact_modes)
     model = Model(name=name, description=description or "a model written as equations",
                   parameters=params, state_names=states, mode_names=mode_names,
-                  methods=built, omega=omega, forcing_amplitude=forcing_amplitude,
+                  methods=built, omega=omega, period=period, forcing_amplitude=forcing_amplitude,
                   contact_modes=contact_modes, **model_kw)
     for mname in built:
         model.fns(mname)  # compile and sample-check now: a malformed model fails here
@@ -310,6 +319,7 @@ class _Context:
         self.sp, self.sym, self.t, self.C, self.S = sp, sym, t, C, S
         self.states = [sym[k] for k in sym if k in states]
         self.omega, self.name = omega, name
+        self.period = None  # the forcing period's parameter name, where the model has one
         self.local = {**sym, "t": t, "pi": sp.pi, **{f: getattr(sp, f) for f in FUNCTIONS},
                       **_smooth_steps(sp)}
 
@@ -526,13 +536,20 @@ def _source(sp, ctx, states, pnames, mode_names, own, fields, rows, branches, in
     # t: the time within the forcing period, 0 <= t < T, whatever the section phase (the
     # kernel's periods run from t_s = phase / omega, so t < t_s + T < 2 T)
     # (a model without forcing: the slot its packed parameters append, its time unit's 1)
-    iw = pnames.index(ctx.omega.name) if ctx.omega is not None else len(pnames)
+    # (a model with a period parameter: T is that parameter)
+    if ctx.period:
+        T_of_p = f"p[{pnames.index(ctx.period)}]"
+        omega_of_p = f"(2.0 * math.pi / {T_of_p})"
+    else:
+        iw = pnames.index(ctx.omega.name) if ctx.omega is not None else len(pnames)
+        omega_of_p = f"p[{iw}]"
+        T_of_p = f"2.0 * math.pi / {omega_of_p}"
     exprs = [e for f in fields.values() for e in f] + [c for c, _ in init] + [
         e for brs in branches.values() for br in brs for c, _, rs in br
         for e in (c, *rs.values())] + [
         r for rs in rows.values() for r in rs if not isinstance(r, list)]
     uses_t = any(ctx.t in sp.sympify(e).free_symbols for e in exprs)
-    wrap_t = [f"    _T = 2.0 * math.pi / p[{iw}]", "    if t >= _T:", "        t -= _T"] \
+    wrap_t = [f"    _T = {T_of_p}", "    if t >= _T:", "        t -= _T"] \
         if uses_t else []
 
     def by_mode(body_of, indent="    ", default="return 0"):
@@ -613,7 +630,7 @@ def _source(sp, ctx, states, pnames, mode_names, own, fields, rows, branches, in
     src += by_mode(transition_body, default="return mode")
 
     src += ["", "", "def initial(c, s, u, p, mem):",
-            f"    t = (math.atan2(s, c) % (2.0 * math.pi)) / p[{iw}]", *unpack_u, *unpack_p]
+            f"    t = (math.atan2(s, c) % (2.0 * math.pi)) / {omega_of_p}", *unpack_u, *unpack_p]
     src += [f"    if {code(cond)}:\n        return {m}" for cond, m in init]
     for m, mname in enumerate(mode_names):
         if mname not in own:

@@ -54,7 +54,7 @@ def _section_points(ds, k):
 def _omega_text(ds) -> str:
     """``, <omega symbol> = value units`` of the model's forcing frequency, or ""."""
     m = model_of(ds)
-    name = m.omega if m is not None else "omega"
+    name = m.forcing_param if m is not None else "omega"
     omega = ds.attrs.get(f"param_{name}")
     if omega is None:
         return ""

@@ -16,7 +16,7 @@ def plot_resonance(ds, show_min: bool = True):
     model's lines of X (support: X = 1)."""
     fig, ax = new_figure(figsize=(8, 5))
     m = model_of(ds)
-    wname = m.omega if m is not None and m.omega in ds else "omega"
+    wname = m.forcing_param if m is not None and m.forcing_param in ds else "omega"
     w = ds[wname].values
     for j, name in enumerate(sweep_names(ds)):
         style = dict(SWEEP_STYLE.get(str(name), dict(color="0.3", marker=".", label=str(name))))
