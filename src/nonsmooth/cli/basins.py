@@ -36,6 +36,9 @@ def basins_cmd(
     orbits_plot: Annotated[Optional[Path], typer.Option("--orbits-plot", help="figure of the coexisting orbits (Fig. 8)")] = None,
     axes: Annotated[Optional[str], typer.Option("--axes", show_default=False, help="the two state components of the grid, A,B (--x and --v are their ranges; e.g. X,Y for impact_2dof); default: the first two")] = None,
     u0: U0Opt = None,
+    entropy: Annotated[bool, typer.Option("--entropy", help="also the basin entropy S_b, the boundary basin entropy S_bb (> ln 2: a fractal boundary) and the uncertainty exponent alpha (1: smooth boundary), written to the same file")] = False,
+    box: Annotated[int, typer.Option("--box", help="box side in grid cells for --entropy")] = 5,
+    entropy_plot: Annotated[Optional[Path], typer.Option("--entropy-plot", help="figure of the box entropies and the fit of alpha (implies --entropy)")] = None,
 ):
     """Basins of attraction (periodic and chaotic attractors found automatically); a Fig. 7-style
     image and a Fig. 8-style figure of the coexisting attractors."""
@@ -48,8 +51,12 @@ def basins_cmd(
     params = load_params(preset, set_, model, "fig7", method=method)
     method = resolve_method(params, method)
     preset = preset_label(params, preset, "fig7")
-    require_output(out, plot if plot is not None else orbits_plot)
-    check_outputs(out, plot, orbits_plot=orbits_plot)
+    require_output(out, plot if plot is not None else orbits_plot or entropy_plot)
+    check_outputs(out, plot, orbits_plot=orbits_plot, entropy_plot=entropy_plot)
+    entropy = entropy or entropy_plot is not None
+    if entropy:
+        from ..analysis.basin_entropy import check_box
+        check_box(box, grid)
     store, engine = chunk_store(out, dask)
     with Progress("basins") as bar, warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always", UserWarning)
@@ -58,8 +65,17 @@ def basins_cmd(
                     early_stop=not no_early_stop, workers=workers,
                     progress=bar, store=store, engine=engine, axes=axes,
                     u0=u0)
+    ent = None
+    if entropy:
+        from ..analysis.basin_entropy import basin_entropy
+        ent = basin_entropy(ds, box)
+        ds = ds.merge(ent, combine_attrs="override")  # the basins' attrs, and the box's
+        ds.attrs["entropy_box"] = box
     from ..plot.basins import plot_basins
     save_outputs(ds, preset, out, plot, plot_basins, store=store)
+    if entropy_plot is not None:
+        from ..plot.basin_entropy import plot_basin_entropy
+        save_figure(plot_basin_entropy(ent), entropy_plot, what="entropy-plot")
     if orbits_plot is not None:
         from ..plot.basins import plot_attractors
         save_figure(plot_attractors(ds), orbits_plot, what="orbits-plot")
@@ -72,6 +88,13 @@ def basins_cmd(
         kind = "chaotic" if int(ds.kind[k]) else f"period {int(ds.period[k])}"
         typer.echo(f"  A{k}: {kind}, contact {int(ds.contact[k])}, max X {float(ds.max_X[k]):.6g}, "
                    f"fraction {float(ds.fraction[k]):.4f}")
+    if ent is not None:
+        sbb = float(ent.boundary_basin_entropy)
+        typer.echo(f"  basin entropy S_b = {float(ent.basin_entropy):.4f}, boundary S_bb = "
+                   f"{sbb:.4f} ({'> ln 2: the boundary is fractal' if sbb > 0.6931471805599453 else '<= ln 2: no fractal boundary shown'}; "
+                   f"{box}x{box}-cell boxes), uncertainty exponent alpha = "
+                   f"{float(ent.uncertainty_exponent):.3f} +- "
+                   f"{float(ent.uncertainty_exponent_stderr):.3f} (1: smooth boundary)")
     for w in caught:
         typer.echo(f"  warning: {w.message}".replace("basins: ", ""))
-    echo_written(out, plot, orbits_plot)
+    echo_written(out, plot, orbits_plot, entropy_plot)

@@ -29,6 +29,7 @@ _PLOTS = {
     "plot_eta_study": ".eta_study",
     "plot_basins": ".basins",
     "plot_attractors": ".basins",
+    "plot_basin_entropy": ".basin_entropy",
     "plot_support_stiffness": ".reproduce_panels",
     "plot_coexisting": ".reproduce_panels",
     "plot_section_panel": ".reproduce_panels",
