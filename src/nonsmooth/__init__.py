@@ -32,6 +32,7 @@ _LAZY = {
     "resonance_curve": ".analysis.resonance",
     "basins": ".analysis.basins",
     "basin_entropy": ".analysis.basin_entropy",
+    "attractor_continuation": ".analysis.attractor_continuation",
     "eta_study": ".analysis.eta_study",
     "lyapunov": ".analysis.stability",
     "periodic_orbit": ".analysis.stability",
@@ -53,7 +54,7 @@ _SUBMODULES = ("analysis", "cli", "errors", "integrate", "io", "kernels", "model
                "plot", "reproduction", "status", "sweep", "chunks")
 
 __all__ = ["__version__", "Params", "PARAM_NAMES", "model", "models", "model_from_equations", "Guard", "preset", "PRESETS", "simulate", "reproduce", "Solver",
-           "eta_study", "lyapunov", "periodic_orbit", "continuation", "two_parameter_curve", "parameter_map", "poincare", "bifurcation_diagram", "resonance_curve", "basins", "basin_entropy",
+           "eta_study", "lyapunov", "periodic_orbit", "continuation", "two_parameter_curve", "parameter_map", "poincare", "bifurcation_diagram", "resonance_curve", "basins", "basin_entropy", "attractor_continuation",
            "surface_section", "surface_bifurcation_diagram", "limit_cycle", "equilibria", "equilibrium_branch",
            "limit_cycle_branch", "surface_basins",
            "NonsmoothError", "ParameterError", "OutputError", "IntegrationError"]

@@ -98,3 +98,64 @@ def basins_cmd(
     for w in caught:
         typer.echo(f"  warning: {w.message}".replace("basins: ", ""))
     echo_written(out, plot, orbits_plot, entropy_plot)
+
+
+@app.command("attractors")
+def attractors_cmd(
+    model: ModelOpt = DEFAULT_MODEL,
+    preset: PresetOpt = None,
+    set_: SetOpt = None,
+    param: Annotated[Optional[str], typer.Option("--param", show_default=False, help="the parameter followed, one of the model's; default: its forcing frequency (omega)")] = None,
+    from_: Annotated[float, typer.Option("--from", help="first value of the range")] = 1.0,
+    to: Annotated[float, typer.Option("--to", help="last value of the range")] = 1.25,
+    steps: Annotated[int, typer.Option("--steps", help="number of values (>= 2)")] = 26,
+    x: Annotated[tuple[float, float], typer.Option("--x", help="range of the initial X: MIN MAX")] = (-3.0, 3.0),
+    v: Annotated[tuple[float, float], typer.Option("--v", help="range of the initial V: MIN MAX")] = (-3.0, 3.0),
+    grid: Annotated[int, typer.Option("--grid", help="initial conditions per axis at each value (>= 2)")] = 40,
+    max_periods: Annotated[int, typer.Option("--max-periods", help="forcing periods allowed per initial condition")] = 1000,
+    match_tol: Annotated[Optional[float], typer.Option("--match-tol", show_default=False, help="largest distance of two section sets taken as one attractor; default: a tenth of the window's diagonal")] = None,
+    method: MethodOpt = None,
+    rtol: RtolOpt = 1e-8,
+    atol: AtolOpt = 1e-10,
+    workers: WorkersOpt = None,
+    out: OutOpt = None,
+    plot: PlotOpt = None,
+):
+    """Attractors followed across a parameter: found at each value from a grid of initial
+    conditions (as basins), matched value to value, with their basin shares, births and
+    deaths."""
+    from ..analysis.attractor_continuation import attractor_continuation
+    from ..sweep import Progress
+    from .analyses import value_range
+
+    params = load_params(preset, set_, model, "fig7", method=method)
+    method = resolve_method(params, method)
+    preset = preset_label(params, preset, "fig7")
+    from ..simulate import check_forced
+    check_forced(params, "attractors")
+    param = params.model.param(param or params.model.forcing_param).name
+    values = value_range(from_, to, steps, f"{param} range")
+    for val in (values[0], values[-1]):
+        params.replace(**{param: float(val)})
+    require_output(out, plot)
+    check_outputs(out, plot)
+    with Progress(f"attractors over {param}") as bar:
+        ds = attractor_continuation(params, param, values, x=x, v=v, grid=grid, method=method,
+                                    match_tol=match_tol, max_periods=max_periods, rtol=rtol,
+                                    atol=atol, workers=workers, progress=bar)
+    from ..plot.attractor_continuation import plot_attractor_continuation
+    save_outputs(ds, preset, out, plot, plot_attractor_continuation)
+    na = ds.sizes["attractor"]
+    typer.echo(f"{preset}: {param} {from_:g} ... {to:g}, {steps} values, {grid}x{grid} initial "
+               f"conditions each: {na} attractor(s) along the path, at most "
+               f"{int(ds.n_attractors.max())} at once")
+    for a in range(na):
+        per = sorted({int(q) for q in ds.period.values[:, a] if q >= 0})
+        kinds = ", ".join("chaotic" if q == 0 else f"period {q}" for q in per)
+        born, died = float(ds.born[a]), float(ds.died[a])
+        life = (f"from {param} = {born:g}" if born == born else "from the first value") + \
+            (f" until {died:g}" if died == died else " to the last")
+        share = ds.fraction.values[:, a][ds.exists.values[:, a] == 1]
+        typer.echo(f"  A{a}: {kinds}; {life}; basin share {share.min():.3f} ... "
+                   f"{share.max():.3f}")
+    echo_written(out, plot)
