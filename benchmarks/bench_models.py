@@ -62,7 +62,8 @@ CASES = (
     ("stick_slip", lambda m: m.params(omega=0.95),
      "defaults, omega = 0.95: stick-slip cycle, Coulomb slip in closed form"),
     ("bouncing_ball", lambda m: m.preset("period_one"),
-     "Gamma = 1.3: the period-one orbit, one impact per period (free flight in closed form)"),
+     "Gamma = 1.3 from Z = V = 0: an orbit that chatters (some 26 impacts) and rides on the "
+     "table once per period (free flight in closed form)"),
     ("impact_2dof", lambda m: m.params(),
      "defaults: one impact per period, four states (closed form between impacts)"),
     ("jeffcott_rotor", lambda m: m.preset("partial_rub"),

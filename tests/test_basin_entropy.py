@@ -146,3 +146,19 @@ def test_surface_basins_read_with_x_first():
     assert d["box_entropy"].dims == ("box_x0", "box_v0")
     assert d.sizes["box_x0"] == 5 and d.sizes["box_v0"] == 3
     assert int(d.boundary_boxes) == 3  # the column of boxes over x0 = 4, 5
+
+
+def test_small_grids_and_repeated_box_sides():
+    """The default box sides fit any grid (a 3 x 3 grid: too few sizes, alpha NaN); repeated
+    sides count once; a side that is not an integer is refused."""
+    d = ns.basin_entropy(np.array([[0, 0, 1], [0, 1, 1], [1, 1, 1]]), 2)
+    assert math.isnan(float(d.uncertainty_exponent)) and int(d.boxes) == 1
+    x, y = grid(64)
+    lab = (x + 0.3 * y > 40).astype(int)
+    a = ns.basin_entropy(lab, 4, epsilons=[2, 3, 3, 4, 6, 8])
+    b = ns.basin_entropy(lab, 4, epsilons=[2, 3, 4, 6, 8])
+    assert a.epsilon.values.tolist() == [2, 3, 4, 6, 8]
+    assert float(a.uncertainty_exponent) == float(b.uncertainty_exponent)
+    assert math.isnan(float(ns.basin_entropy(lab, 4, epsilons=[4, 4, 4]).uncertainty_exponent))
+    with pytest.raises(ParameterError, match="integers"):
+        ns.basin_entropy(lab, 4, epsilons=[2.5, 3, 4])

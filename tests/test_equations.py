@@ -262,3 +262,20 @@ def test_a_model_file_of_equations_runs_from_the_cli(tmp_path):
     assert r.returncode == 0, r.stderr
     ds = ns.io.load_dataset(tmp_path / "p.nc")
     assert int(ds.period) == 1 and ds.attrs["model"] == "impact_eq"
+
+
+def test_a_self_excited_cycle_is_the_same_with_a_period_parameter():
+    """A van der Pol oscillator (no forcing amplitude) declared with a period parameter: its
+    limit cycle and the orbit sampled over one turn are those of the same model declared with
+    omega (the sampling sets the frame slot to the sample interval: a period, not 2 pi / it)."""
+    kw = dict(states=("X", "V"), modes={"free": ["V", "mu*(1 - X**2)*V - X"]},
+              method="smooth")
+    mt = ns.model_from_equations("vdp_T", parameters={"mu": 1.0, "T": 3.0}, period="T",
+                                 forcing_amplitude=None, **kw)
+    mw = ns.model_from_equations("vdp_w", parameters={"mu": 1.0, "omega": 2 * math.pi / 3.0},
+                                 **kw)
+    a = ns.limit_cycle(mt.params(), "V", x0=1.0, method="smooth")
+    b = ns.limit_cycle(mw.params(), "V", x0=1.0, method="smooth")
+    assert float(a.period) == pytest.approx(float(b.period), rel=1e-9)
+    assert float(a.max_X) == pytest.approx(float(b.max_X), abs=1e-8)
+    assert float(a.max_X) == pytest.approx(2.0086, abs=1e-3)  # van der Pol, mu = 1

@@ -529,9 +529,11 @@ def _sample_cycle(params, solver, state, period, samples):
     for i in range(samples):
         U[i] = state_u(params.model, s)
         R[i] = int(s[ST_MODE])
-        # one output interval of length dt: a "period" T' = dt (omega' = 2 pi / dt)
+        # one output interval of length dt: a "period" T' = dt (omega' = 2 pi / dt; the
+        # slot of a model's forcing period holds T' itself)
         pp = p.copy()
-        pp[params.model.frame_index] = 2.0 * math.pi / dt
+        pp[params.model.frame_index] = dt if params.model.period is not None else \
+            2.0 * math.pi / dt
         bufs = output_buffers(1)
         code = run(KERNEL_GENERIC, solver.fns, pp, opts, s, 1, 0, 1, *bufs)
         if code != st.OK:

@@ -112,8 +112,10 @@ def _entropy_of(labels, box):
 def default_epsilons(shape) -> np.ndarray:
     """Box sides (cells) for the exponent's fit: from 2 to an eighth of the shorter side
     (at least 4), about geometrically spaced."""
-    top = max(4, min(shape) // 8)
-    return np.unique(np.round(np.geomspace(2, top, 8)).astype(np.int64))
+    m = min(shape)
+    top = min(max(4, m // 8), m)
+    return np.unique(np.round(np.geomspace(2, top, 8)).astype(np.int64)) if m >= 2 else \
+        np.array([2])
 
 
 def uncertainty_exponent(labels, epsilons=None):
@@ -121,11 +123,15 @@ def uncertainty_exponent(labels, epsilons=None):
     (``epsilons``) and the least-squares slope alpha of ln f against ln(e - 1) over the sizes
     with f > 0 (NaN with fewer than three)."""
     lab = _labels(labels)
-    eps = default_epsilons(lab.shape) if epsilons is None else np.asarray(epsilons, np.int64)
-    if eps.ndim != 1 or eps.size == 0 or np.any(eps < 2) or np.any(
-            eps > min(lab.shape)):
-        raise ParameterError(f"epsilons: box sides must be between 2 and {min(lab.shape)} "
-                             f"cells, got {eps.tolist()}")
+    if epsilons is None:
+        eps = default_epsilons(lab.shape)
+    else:
+        raw = np.asarray(epsilons, dtype=np.float64).ravel()
+        if raw.size == 0 or not np.all(np.isfinite(raw)) or np.any(raw != np.round(raw)) or \
+                np.any(raw < 2) or np.any(raw > min(lab.shape)):
+            raise ParameterError(f"epsilons: box sides must be integers between 2 and "
+                                 f"{min(lab.shape)} cells, got {raw.tolist()}")
+        eps = np.unique(raw.astype(np.int64))
     f = np.array([nb / max(n, 1) for n, nb in (_entropy_of(lab, int(e))[2:] for e in eps)],
                  dtype=np.float64)
     ok = f > 0.0  # (f = 1, every box on the boundary, is the plateau of alpha = 0)
@@ -180,7 +186,8 @@ def basin_entropy(basins, box: int = 5, *, epsilons=None) -> xr.Dataset:
                 "box_cells": box}),
             "boundary_basin_entropy": ((), Sbb, {
                 "long_name": "boundary basin entropy S_bb: mean entropy of the boxes that hold "
-                             "more than one attractor", "units": "1", "box_cells": box}),
+                             "more than one attractor (0 where none does)", "units": "1",
+                "box_cells": box}),
             "fractal_boundary": ((), np.int8(fractal), {
                 "long_name": "S_bb > ln 2 (a sufficient condition for a fractal boundary; 0: "
                              "not shown)", "flag_values": np.array([0, 1], np.int8),
@@ -201,8 +208,8 @@ def basin_entropy(basins, box: int = 5, *, epsilons=None) -> xr.Dataset:
             "box_attractors": ((f"box_{xname}", f"box_{vname}"), k.astype(np.int32), {
                 "long_name": "attractors reached from the box", "units": "1"}),
         },
-        coords={"epsilon": ("epsilon", eps, {"long_name": "box side e (the fit's scale: e - 1 "
-                                                  "cell widths)", "units": "cells"}),
+        coords={"epsilon": ("epsilon", eps, {"long_name": "box side e in grid cells (the fit's "
+                                                  "scale: e - 1 cell widths)", "units": "1"}),
                 **coords},
         attrs=clean_attrs(attrs),
     )

@@ -23,7 +23,8 @@ Design summary
   (``_guard_exit``): ends that clear zero by twice the Hermite slope bound pass at once;
   otherwise the step is halved left to right until each piece's Hermite of (g, g'), less an
   error bound estimated from the true g at its midpoint, clears zero, so grazing dips are
-  found; the crossing is located by Illinois on the true g. Its gradient enters the saltation
+  found; the crossing is located by Illinois on the true g (on a series piece, whose guard is a
+  polynomial, by Newton: ``linmodes.poly_root``). Its gradient enters the saltation
   matrix. A mode with a curved guard is never taken in the oscillator's closed form (the
   series of ``linmodes`` evaluates curved guards on its exact polynomial).
 * A guard with forcing terms (G[k, n+1], G[k, n+2]) is not a cubic along a step, and a step can
@@ -362,12 +363,16 @@ def _locate(cf, lo, hi, glo, ghi, G, k, n, q0, q1, q2, q3, C, S, om, hs, MC, mod
         lo, hi, glo, ghi, side = illinois_update(lo, hi, glo, ghi, side, sm, gm)
     return lo, hi
 
+
 @nb.njit(cache=True, inline="always")
 def frame_omega(pp, opts):
     """The frequency omega that frames time: p[opts[OPT_OMEGA]], or 2 pi / T where that slot
-    holds the forcing period T (``opts[OPT_FRAME_PERIOD]``, a model's ``period``)."""
+    holds the forcing period T (``opts[OPT_FRAME_PERIOD]``, a model's ``period``; T = 0 gives
+    -1, which the kernel reports as NON_FINITE like omega <= 0)."""
     f = pp[int(opts[OPT_OMEGA])]
-    return 2.0 * math.pi / f if opts[OPT_FRAME_PERIOD] == 1.0 else f
+    if opts[OPT_FRAME_PERIOD] == 1.0:
+        return 2.0 * math.pi / f if f != 0.0 else -1.0
+    return f
 
 
 @nb.njit(cache=True)
@@ -589,7 +594,8 @@ def _guard_exit(kind, cp, curved, mode, k, tau, C, S, hs, om, n, u, f0, u1, f1, 
 
     A step whose ends clear zero is passed at once (kind 0: the Hermite less the polynomial's
     bound of g''''; kind 1: by twice the Hermite slope bound). Otherwise the first negative
-    piece (``_guard_scan``) is bracketed, the crossing located by Illinois on the true g, and
+    piece (``_guard_scan``) is bracketed, the crossing located by Illinois on the true g (kind
+    0, a polynomial: by Newton, ``linmodes.poly_root``), and
     [0, lo] scanned again, so that a dip and a return before it are found too (the first
     crossing, grazing dips included; ``_first_crossing`` does this for the other guards)."""
     g0, d0 = _g_eval(kind, 0.0, cp, curved, mode, k, tau, C, S, hs, om, n, u, f0, u1, f1, pp,

@@ -155,7 +155,8 @@ def poly_x_extrema(TW, hs, xmax, xmin, cv):
     """(xmax, xmin) with the interior extrema of X = z[0] on the piece [0, hs]: where
     V = z[0]' changes sign between X_SAMPLES + 1 points (a piece spans THETA_POLY = 2 of the
     fastest rate: at most one sign change is expected between two of them), located by
-    ``poly_root`` on V (``cv``: work, N_TAYLOR + 1)."""
+    ``poly_root`` on V (``cv``: work, N_TAYLOR + 1; the kernel lends it the guard's
+    polynomial ``cp``, rebuilt before every use)."""
     va = poly_component(TW, 0, 0.0)[1]
     for q in range(1, X_SAMPLES + 1):  # V at X_SAMPLES points: each sign change an extremum
         a = (q - 1) * hs / X_SAMPLES
@@ -166,7 +167,8 @@ def poly_x_extrema(TW, hs, xmax, xmin, cv):
             for j in range(N_TAYLOR):
                 cv[j] = sg * (j + 1) * TW[j + 1, 0]
             cv[N_TAYLOR] = 0.0
-            lo, hi = poly_root(cv, hs, a / hs, b / hs, sg * va, sg * vb, 1e-15)
+            lo, hi = poly_root(cv, hs, (q - 1) / X_SAMPLES, q / X_SAMPLES, sg * va, sg * vb,
+                               1e-15)
             x = poly_component(TW, 0, 0.5 * (lo + hi) * hs)[0]
             xmax = max(xmax, x)
             xmin = min(xmin, x)
@@ -241,11 +243,13 @@ def poly_root(c, hs, lo, hi, glo, ghi, tol):
             lo = x
         if hi - lo <= tol:
             break
-        dx = -g / (d * hs) if d != 0.0 else math.inf
-        if abs(dx) < 0.25 * tol:  # converged: step past the root, to close the bracket
+        dh = d * hs
+        dx = -g / dh if dh != 0.0 else math.inf
+        past = abs(dx) < 0.25 * tol
+        if past:  # converged: step past the root, to close the bracket
             dx = 0.5 * tol if dx >= 0.0 else -0.5 * tol
         xn = x + dx
-        if not (lo < xn < hi and abs(dx) <= 0.5 * dx_old):
+        if not (lo < xn < hi and (past or abs(dx) <= 0.5 * dx_old)):
             xn = 0.5 * (lo + hi)
             dx = xn - x
         dx_old = abs(dx)

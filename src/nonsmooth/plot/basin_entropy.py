@@ -30,14 +30,13 @@ def plot_basin_entropy(ds, axes=None):
     Sb, Sbb = float(ds["basin_entropy"]), float(ds["boundary_basin_entropy"])
     ax.set_title(rf"$S_b$ = {Sb:.3f}, $S_{{bb}}$ = {Sbb:.3f} "
                  + (r"> ln 2: fractal" if int(ds["fractal_boundary"]) else r"(<= ln 2)")
-                 + f"\n{int(ds.attrs.get('box', 0))} x {int(ds.attrs.get('box', 0))} cells "
-                   f"per box", fontsize=10)
+                 + f"\n{_box(ds)} x {_box(ds)} cells per box", fontsize=10)
     e = np.asarray(ds["epsilon"].values, dtype=float) - 1.0
     f = np.asarray(ds["boundary_share"].values, dtype=float)
     ok = (f > 0) & (e > 0)
     bx.loglog(e[ok], f[ok], "o", color="k", label=r"$f$ = boundary boxes / boxes")
     a, se = float(ds["uncertainty_exponent"]), float(ds["uncertainty_exponent_stderr"])
-    fit = ok & (f < 1.0)
+    fit = ok  # the reported fit: every size with f > 0 (f = 1 is the plateau alpha = 0)
     if math.isfinite(a) and np.count_nonzero(fit) >= 2:
         x = np.log(e[fit])
         c = float(np.mean(np.log(f[fit]) - a * x))
@@ -52,3 +51,8 @@ def plot_basin_entropy(ds, axes=None):
     if title:
         fig.suptitle(title, fontsize=10)
     return fig
+
+
+def _box(ds) -> int:
+    """The box side of the entropies (also in a basins file that ``--entropy`` wrote)."""
+    return int(ds["basin_entropy"].attrs.get("box_cells", ds.attrs.get("box", 0)))
