@@ -64,6 +64,16 @@ def _accepted(br, y, it):
     return y, ev, it
 
 
+def bordered_step(J, t, F, h):
+    """The Newton step d of the bordered system [J; t] d = -[F; h] (the corrector in the
+    hyperplane normal to the tangent t), or None when it is singular or not finite."""
+    try:
+        d = np.linalg.solve(np.vstack([J, t[None, :]]), -np.r_[F, h])
+    except np.linalg.LinAlgError:
+        return None
+    return d if np.all(np.isfinite(d)) else None
+
+
 class _Branch:
     """The map, its derivatives and the corrector at one parameter index."""
 
@@ -110,14 +120,9 @@ class _Branch:
             F = ev[0]
             act, ia, J = self.jacobian(ev)
             tt = np.concatenate([t[ia], t[N:]])
-            A = np.vstack([J, tt[None, :]])
-            rhs = -np.concatenate([F[ia], [tt @ (np.concatenate([y[ia], y[N:]])
-                                                 - np.concatenate([y_pred[ia], y_pred[N:]]))]])
-            try:
-                d = np.linalg.solve(A, rhs)
-            except np.linalg.LinAlgError:
-                return None
-            if not np.all(np.isfinite(d)):
+            d = bordered_step(J, tt, F[ia], tt @ (np.concatenate([y[ia], y[N:]])
+                                                  - np.concatenate([y_pred[ia], y_pred[N:]])))
+            if d is None:
                 return None
             y[ia] += d[:-1]
             y[N] += d[-1]

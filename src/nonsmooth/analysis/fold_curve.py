@@ -1,0 +1,282 @@
+"""A fold of periodic orbits continued in two parameters as one extended system, through its
+turning points, with its cusps located (issue 21, item 4, for folds).
+
+``fold_curve(params, "omega", "omega_s", start=branch) -> xarray.Dataset``
+
+The unknowns are the section point z of a k-periodic orbit and the two parameters (l1, l2);
+the equations are the orbit condition and the fold condition,
+
+    P^k(z; l1, l2) - z = 0,    g = det(M - I) = 0    (M = dP^k/dz, the monodromy),
+
+n + 1 equations in n + 2 unknowns: a curve, followed by pseudo-arclength steps (the same
+predictor, corrector and step control as :func:`nonsmooth.continuation`, ``continuation._follow``)
+in (z, l2, l1). The monodromy comes from the tangent kernel; the derivatives of P in l1, l2 are
+central differences of the kernel's map, those of g forward differences of the monodromy
+(the corrector converges with them; the residual it drives to zero is exact). Unlike
+:func:`nonsmooth.two_parameter_curve`, which re-locates the fold on a fresh branch at each value
+of the second parameter and stops where a fold vanishes, the curve turns where it turns in
+either parameter and runs through a **cusp**, where two folds meet and the hysteresis between
+them vanishes: there the curve's projection on (l1, l2) reverses, both parameter components of
+its tangent changing sign within one step. A cusp is reported at the zero of the parameter
+speed, interpolated between the two points that bracket it.
+
+The fold condition det(M - I) = 0 also holds at a multiplier 1 that is not a fold (a
+transcritical or pitchfork point): the curve follows whatever has a multiplier 1.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import xarray as xr
+
+from .. import status as st
+from ..errors import ParameterError
+from ..io import apply_state_units, components, provenance_attrs
+from ..kernels import new_state, output_buffers, run
+from ..models.base import KERNEL_GENERIC
+from ..simulate import component_variables
+from ..tangent import TangentSetup, period_map
+from .continuation import (FOLD, GRAZING, NEIMARK_SACKER, PERIOD_DOUBLING, _accepted, _follow,
+                           bordered_step, branch_arguments)
+from .stability import _active, _section_state
+
+
+class _FoldBranch:
+    """The extended system at parameter indices (i1, i2): coordinates y = (z, l2), then l1."""
+
+    def __init__(self, setup: TangentSetup, p0, i1: int, i2: int, k: int, tol: float):
+        self.setup, self.p0, self.i1, self.i2, self.k, self.tol = setup, p0, i1, i2, k, tol
+        self.N = setup.N + 1
+        self.template = None
+
+    def p(self, l1, l2):
+        p = self.p0.copy()
+        p[self.i1] = l1
+        p[self.i2] = l2
+        return p
+
+    def _map(self, z, l1, l2):
+        """(P(z) - z, M, g, start state) or None."""
+        p = self.p(l1, l2)
+        s0 = _section_state(self.setup, p, z, self.template)
+        s1, M, code, _ = period_map(self.setup, p, s0, self.k)
+        if code != st.OK:
+            return None
+        act = _active(M, self.setup.n)
+        Ma = M[np.ix_(act, act)]
+        g = float(np.linalg.det(Ma - np.eye(len(Ma))))
+        return self.setup.z_of(s1) - z, M, g, s0
+
+    def _ends(self, z, l1, l2, s0):
+        s = _section_state(self.setup, self.p(l1, l2), z, s0)
+        if run(KERNEL_GENERIC, self.setup.fns, self.p(l1, l2), self.setup.opts, s, 1, self.k,
+               0, *output_buffers(0)) != st.OK:
+            return None
+        return self.setup.z_of(s)
+
+    def evaluate(self, w, l1):
+        """(G, J, None, start state, M): G = (P - z, g) at (z, l2) = w and l1, J its Jacobian
+        in (z, l2, l1) ((N + 1) x (N + 2)); None when a trajectory fails."""
+        Nz = self.setup.N
+        z, l2 = w[:Nz], float(w[Nz])
+        base = self._map(z, l1, l2)
+        if base is None:
+            return None
+        F, M, g, s0 = base
+        J = np.zeros((Nz + 1, Nz + 2))
+        J[:Nz, :Nz] = M - np.eye(Nz)
+        for col, (a, b) in ((Nz, (0.0, 1.0)), (Nz + 1, (1.0, 0.0))):  # l2, then l1
+            h = 1e-7 * max(1.0, abs(l1 if a else l2))
+            hi = self._ends(z, l1 + a * h, l2 + b * h, s0)
+            lo = self._ends(z, l1 - a * h, l2 - b * h, s0)
+            if hi is None or lo is None:
+                return None
+            J[:Nz, col] = (hi - lo) / (2.0 * h)
+        for j in range(Nz + 2):  # dg: forward differences of det(M - I)
+            h = 1e-6 * max(1.0, abs(z[j]) if j < Nz else abs(l2 if j == Nz else l1))
+            zz = z.copy()
+            ll1, ll2 = l1, l2
+            if j < Nz:
+                zz[j] += h
+            elif j == Nz:
+                ll2 += h
+            else:
+                ll1 += h
+            other = self._map(zz, ll1, ll2)
+            if other is None:
+                return None
+            J[Nz, j] = (other[2] - g) / h
+        return np.r_[F, g], J, None, s0, M
+
+    def correct(self, y_pred, t, base=None, max_iter=12):
+        """Newton onto G = 0 in the hyperplane t . (y - y_pred) = 0: (y, evaluation, its) or
+        None."""
+        y = y_pred.copy()
+        N = self.N
+        for it in range(1, max_iter + 1):
+            ev = self.evaluate(y[:N], y[N])
+            if ev is None:
+                return None
+            G, J = ev[0], ev[1]
+            d = bordered_step(J, t, G, t @ (y - y_pred))
+            if d is None:
+                return None
+            y += d
+            small = np.linalg.norm(G) <= self.tol * (1.0 + np.linalg.norm(y[:N - 1]))
+            if small and np.linalg.norm(d) <= 1e3 * self.tol * (1.0 + np.linalg.norm(y)):
+                return _accepted(self, y, it)
+        return None
+
+    def tangent(self, ev, t_prev):
+        J = ev[1]
+        try:
+            v = np.linalg.solve(np.vstack([J, t_prev[None, :]]), np.r_[np.zeros(len(J)), 1.0])
+        except np.linalg.LinAlgError:
+            v = t_prev.copy()
+        return v / np.linalg.norm(v)
+
+    def features(self, y, ev, t):
+        M = ev[4]
+        act = _active(M, self.setup.n)
+        mu = np.linalg.eigvals(M[np.ix_(act, act)])
+        mu = mu[np.argsort(-np.abs(mu), kind="stable")]
+        return dict(mu=mu, t=t.copy(), tests={FOLD: math.nan, PERIOD_DOUBLING: math.nan,
+                                              NEIMARK_SACKER: math.nan, GRAZING: math.nan})
+
+
+def _cusps(pts, N):
+    """(l1, l2, index) of each cusp: the curve's velocity in (l1, l2) (the parameter part of
+    its unit tangent) turns by more than a right angle between points i and i + 1 (at a cusp
+    it vanishes and reverses; at an ordinary turning point only one component vanishes and it
+    turns smoothly); the cusp at the interpolated zero of its component along the velocity at
+    point i."""
+    out = []
+    for i in range(len(pts) - 1):
+        (ya, fa), (yb, fb) = pts[i], pts[i + 1]
+        va = np.array([fa["t"][N], fa["t"][N - 1]])
+        vb = np.array([fb["t"][N], fb["t"][N - 1]])
+        da, db = float(va @ va), float(va @ vb)
+        if db < 0.0 < da:
+            s = da / (da - db)
+            y = ya + s * (yb - ya)
+            out.append((float(y[N]), float(y[N - 1]), i))
+    return out
+
+
+def fold_curve(params, param: str, param2: str, *, start, special: int | None = None,
+               direction: str = "up", step: float = 0.01, max_step: float | None = None,
+               bounds=None, bounds2=None, max_points: int = 300, tol: float = 1e-9,
+               rtol: float = 1e-10, atol: float = 1e-12) -> xr.Dataset:
+    """The fold of ``start`` (a :func:`nonsmooth.continuation` Dataset in ``param`` of the same
+    model and method: its fold special point ``special``, default the first) continued in
+    (``param``, ``param2``) as the extended system of the module documentation, from the
+    value of ``param2`` in ``params``, ``direction`` "up" (``param2`` increasing at first) or
+    "down", with arclength steps from ``step`` (adapted up to ``max_step``, default 10 x) until
+    ``param`` leaves ``bounds`` or ``param2`` leaves ``bounds2`` (default: unbounded),
+    ``max_points`` or the corrector fails.
+
+    Returns a Dataset over ``point``: ``<param>``, ``<param2>``, the section point
+    (``X_section``, ``V_section``, ...), the multipliers (``multiplier_real/imag/abs``, one of
+    them 1 on the curve), and over ``cusp`` the located cusps (``cusp_<param>``,
+    ``cusp_<param2>``, ``cusp_after_point``); attrs ``status``."""
+    from ..kernels import Solver
+    from ..simulate import check_params
+    params = check_params(params)
+    m = params.model
+    p1, p2 = m.param(param).name, m.param(param2).name
+    if p1 == p2:
+        raise ParameterError(f"param2: must differ from param ({p1})")
+    if not isinstance(start, xr.Dataset) or "special_type" not in start or \
+            start.attrs.get("param") != p1:
+        raise ParameterError(f"start: expected the Dataset of continuation(..., {p1!r}, ...) "
+                             f"with a fold")
+    if start.attrs.get("model") != m.name:
+        raise ParameterError(f"start: a branch of model {start.attrs.get('model')}, not {m.name}")
+    folds = np.flatnonzero(start.special_type.values == FOLD)
+    if special is None:
+        if folds.size == 0:
+            raise ParameterError("start: the branch has no fold")
+        special = int(folds[0])
+    elif not (0 <= special < start.sizes["special"]) or start.special_type.values[special] != FOLD:
+        raise ParameterError(f"special: {special!r} is not a fold of the branch (folds: "
+                             f"{folds.tolist()})")
+    if "section_moved" in start.attrs or "section" in start.attrs:
+        raise ParameterError("start: a branch whose section moved, or of limit cycles, is not "
+                             "supported here")
+    _, _, max_points, step, max_step, tol, lo, hi = branch_arguments(
+        params, p1, 1, max_points, step, max_step, tol, direction, bounds, False)
+    lo2, hi2 = branch_arguments(params, p2, 1, max_points, step, max_step, tol, direction,
+                                 bounds2, False)[6:] if bounds2 is not None else (-math.inf,
+                                                                                  math.inf)
+    k = int(start.attrs.get("k", 1))
+    method = str(start.attrs.get("method", "exact"))
+    solver = Solver(method=method, rtol=rtol, atol=atol, model=m)
+    setup = TangentSetup(solver)
+    l1 = float(start[f"special_{p1}"].values[special])
+    l2 = float(getattr(params, p2))
+    params = params.replace(**{p1: l1})
+    p0 = params.pack()
+    br = _FoldBranch(setup, p0, m.index[p1], m.index[p2], k, tol)
+    Nz = setup.N
+    z0 = np.zeros(Nz)
+    zc = np.asarray(components(start, "special_", "_section").values[special], dtype=float)
+    z0[:len(zc)] = zc  # (continuous memory, if any, starts from 0 and is mapped at once)
+    br.template = new_state(0.0, 0.0)  # mode -1: classified at each point
+    # the fold from the branch, refined on the extended system at fixed l2 (a step of zero
+    # length along l2)
+    t = np.zeros(Nz + 2)
+    t[Nz] = 1.0
+    y = np.r_[z0, l2, l1]
+    got = br.correct(y, t)
+    if got is None:
+        raise ParameterError(f"start: the fold at {p1} = {l1:g} does not converge on the "
+                             f"extended system")
+    y, ev, _ = got
+    sign = 1.0 if direction == "up" else -1.0
+    t = br.tangent(ev, sign * t)
+    if t[Nz] * sign < 0:
+        t = -t
+    pts = [(y, br.features(y, ev, t))]
+    # (_follow bounds the last coordinate, param; param2's bounds are applied after)
+    _, _, _, status = _follow(br, pts, t, step, max_step, max_points, lo, hi)
+    ys = np.array([y for y, _ in pts])
+    out2 = np.flatnonzero((ys[:, Nz] < lo2) | (ys[:, Nz] > hi2))
+    if out2.size:
+        pts = pts[:out2[0] + 1]
+        status = f"left the bounds of {p2}"
+    cusps = _cusps(pts, Nz + 1)
+    return _dataset(params, solver, p1, p2, k, pts, cusps, status, Nz)
+
+
+def _dataset(params, solver, p1, p2, k, pts, cusps, status, Nz):
+    m = params.model
+    ys = np.array([y for y, _ in pts])
+    mu = np.array([f["mu"] for _, f in pts])
+    U = ys[:, :min(Nz, m.n)]
+    s1, s2 = m.param(p1), m.param(p2)
+    ds = xr.Dataset(
+        {
+            p1: ("point", ys[:, Nz + 1], {"long_name": s1.long_name or p1, "units": s1.units}),
+            p2: ("point", ys[:, Nz], {"long_name": s2.long_name or p2, "units": s2.units}),
+            "X_section": ("point", U[:, 0], {"long_name": "X at the section (t = kT)"}),
+            "V_section": ("point", U[:, 1], {"long_name": "V at the section (t = kT)"}),
+            "multiplier_real": (("point", "multiplier"), mu.real, {"units": "1"}),
+            "multiplier_imag": (("point", "multiplier"), mu.imag, {"units": "1"}),
+            "multiplier_abs": (("point", "multiplier"), np.abs(mu), {"units": "1"}),
+            "cusp_" + p1: ("cusp", np.array([c[0] for c in cusps], float),
+                           {"long_name": f"{p1} at the cusp", "units": s1.units}),
+            "cusp_" + p2: ("cusp", np.array([c[1] for c in cusps], float),
+                           {"long_name": f"{p2} at the cusp", "units": s2.units}),
+            "cusp_after_point": ("cusp", np.array([c[2] for c in cusps], np.int64),
+                                 {"long_name": "the cusp lies between this point and the next"}),
+        },
+        coords={"point": np.arange(len(pts)), "multiplier": np.arange(1, mu.shape[1] + 1),
+                "cusp": np.arange(len(cusps))},
+        attrs=provenance_attrs(params, solver, swept=(p1, p2), analysis="fold_curve",
+                               param=p1, param2=p2, k=k, status=status, n_cusps=len(cusps)),
+    )
+    ds.update(component_variables(m, ("point",), U, suffix="_section",
+                                  what=" at the section (t = kT)"))
+    return apply_state_units(ds, m)
