@@ -170,3 +170,16 @@ def test_far_start_fails_gracefully(method):
     assert time.perf_counter() - t < 5.0
     assert orb.attrs["status"] != "converged"
     assert orb.attrs["verdict"] == "not found"
+
+
+def test_multipliers_of_a_state_at_rest_smoothed_method():
+    """Unforced (F0 = 0), the rest state is the orbit: its multipliers are those of the linear
+    free oscillator, |mu| = exp(-xi T / 2). The RKF45's error estimate of a state at rest is 0;
+    the steps must still be short enough for the tangent (they were a whole period, and the
+    smoothed method gave |mu| = 4.25, an unstable rest state)."""
+    p = ns.preset("table3").replace(F0=0.0)
+    for method in ("smooth", "exact"):
+        o = ns.periodic_orbit(p, method=method)
+        assert o.attrs["status"] == "converged"
+        np.testing.assert_allclose(o.multiplier_abs.values, math.exp(-p.xi * p.period / 2),
+                                   rtol=1e-7)

@@ -756,12 +756,14 @@ def _cf_state(MC, mode, om, y0, z0, C, S, hs, u1, f1):
 # ---- tangent (variational) dynamics ---------------------------------------------------------
 @nb.njit(cache=True, inline="always", fastmath=_FM)
 def _rk_tangent(jacobian, mode, tau, C, S, h, om, n, u, k0, k1, k2, k3, k4, k5, pp, mem, Y, W, KY,
-                J, us, cmi):
+                J, us, cmi, rtol, atol):
     """Propagate the tangent Y (rows: u, then the continuous memory slots ``cmi``) through the
     RKF45 step just taken (its stages k0..k5, length h): the same Runge-Kutta formula applied
     to the variational equation Y' = J Y with J the model's Jacobian at each stage state, i.e.
     the exact derivative of the discrete step (internal differentiation). Memory rows are
-    constant within a mode; J's columns n + slot give the field's dependence on memory."""
+    constant within a mode; J's columns n + slot give the field's dependence on memory.
+    Returns the squared RMS norm of the step's embedded error estimate on the tangent, each
+    column scaled by atol + rtol max|column| (the step-size control takes it with the state's)."""
     m = Y.shape[1]
     ncm = len(cmi)
     # forcing phase at the stage times 0, 1/4, 3/8, 12/13, 1, 1/2 of the step
@@ -826,10 +828,19 @@ def _rk_tangent(jacobian, mode, tau, C, S, h, om, n, u, k0, k1, k2, k3, k4, k5, 
                     acc += J[r, n + cmi[q]] * Y[n + q, c]
                 KY[i, r, c] = acc
     b0, b1, b2, b3, b4, b5 = _B[0], _B[1], _B[2], _B[3], _B[4], _B[5]
+    err2 = 0.0
     for c in range(m):
+        scale = 0.0
         for r in range(n):
             Y[r, c] += h * (b0 * KY[0, r, c] + b1 * KY[1, r, c] + b2 * KY[2, r, c]
                             + b3 * KY[3, r, c] + b4 * KY[4, r, c] + b5 * KY[5, r, c])
+            scale = max(scale, abs(Y[r, c]))
+        sc = atol + rtol * scale
+        for r in range(n):
+            e = h * (_E[0] * KY[0, r, c] + _E[2] * KY[2, r, c] + _E[3] * KY[3, r, c]
+                     + _E[4] * KY[4, r, c] + _E[5] * KY[5, r, c]) / sc
+            err2 += e * e
+    return err2 / max(m * n, 1)
 
 
 @nb.njit(cache=True, inline="always", fastmath=_FM)
@@ -1370,18 +1381,22 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
                         if not math.isfinite(u1[0]):
                             code = st.NON_FINITE
                             break
-                elif not cf and not pm:
-                    # step-size control after an accepted step without a switch
-                    h = _control(err2, hs, h, last, rejected)
-                    rejected = False
+                errY2 = 0.0
                 if tan:
                     if cf:
                         _cf_tangent(MC, mode, om, hs, Y, PT)
                     elif pm:
                         poly_tangent(MX[mode], n, hs, Y, pt0, pt1)
                     else:
-                        _rk_tangent(jacobian, mode, tau, C, S, hs, om, n, u, f0, k1, k2, k3, k4,
-                                    k5, pp, mem, Y, W, KY, J, us, cmi)
+                        errY2 = _rk_tangent(jacobian, mode, tau, C, S, hs, om, n, u, f0, k1, k2,
+                                            k3, k4, k5, pp, mem, Y, W, KY, J, us, cmi, rtol,
+                                            atol)
+                if k_tr < 0 and not cf and not pm:
+                    # step-size control after an accepted step without a switch; with tangent
+                    # vectors, also by their error (at rest the state's estimate is 0, and a
+                    # step of a whole period would give the tangent of the RK polynomial)
+                    h = _control(max(err2, errY2), hs, h, last, rejected)
+                    rejected = False
                 if cf:
                     xmax, xmin = _x_extrema_exact(MC, mode, om, y0, z0, C, S, u[0], u[1], u1[0],
                                                   u1[1], hs, xmax, xmin)
