@@ -97,9 +97,9 @@ def check_box(box, grid) -> int:
     return int(box)
 
 
-def _entropy_of(labels, box):
-    """(S_b, S_bb, N, N_b) for boxes of ``box`` cells."""
-    S, k, decided = box_entropies(labels, box)
+def _entropy_of(boxes):
+    """(S_b, S_bb, N, N_b) of the :func:`box_entropies` ``boxes``."""
+    S, k, decided = boxes
     used = decided > 0
     N = int(np.count_nonzero(used))
     Nb = int(np.count_nonzero(k > 1))
@@ -132,7 +132,8 @@ def uncertainty_exponent(labels, epsilons=None):
             raise ParameterError(f"epsilons: box sides must be integers between 2 and "
                                  f"{min(lab.shape)} cells, got {raw.tolist()}")
         eps = np.unique(raw.astype(np.int64))
-    f = np.array([nb / max(n, 1) for n, nb in (_entropy_of(lab, int(e))[2:] for e in eps)],
+    f = np.array([nb / max(n, 1) for n, nb in (_entropy_of(box_entropies(lab, int(e)))[2:]
+                                               for e in eps)],
                  dtype=np.float64)
     ok = f > 0.0  # (f = 1, every box on the boundary, is the plateau of alpha = 0)
     if np.count_nonzero(ok) < 3:
@@ -156,8 +157,8 @@ def basin_entropy(basins, box: int = 5, *, epsilons=None) -> xr.Dataset:
     for the figure), f(eps) (``boundary_share``), the fit, and the basins' attrs."""
     lab = _labels(basins)
     box = check_box(box, lab.shape)
-    S, k, decided = box_entropies(lab, box)
-    Sb, Sbb, N, Nb = _entropy_of(lab, box)
+    S, k, decided = boxes = box_entropies(lab, box)
+    Sb, Sbb, N, Nb = _entropy_of(boxes)
     alpha, alpha_se, eps, f = uncertainty_exponent(lab, epsilons)
     n_att = int(lab.max()) + 1 if lab.size else 0
     src = basins.attrs if isinstance(basins, xr.Dataset) else {}
