@@ -26,6 +26,7 @@ from . import stability  # noqa: E402,F401
 from . import continuation  # noqa: E402,F401
 from . import parameter_map  # noqa: E402,F401
 from . import autonomous  # noqa: E402,F401
+from . import manifolds  # noqa: E402,F401
 
 def _terminate(signum, frame):
     raise Terminated()

@@ -31,6 +31,7 @@ _PLOTS = {
     "plot_attractors": ".basins",
     "plot_basin_entropy": ".basin_entropy",
     "plot_attractor_continuation": ".attractor_continuation",
+    "plot_manifolds": ".manifolds",
     "plot_support_stiffness": ".reproduce_panels",
     "plot_coexisting": ".reproduce_panels",
     "plot_section_panel": ".reproduce_panels",

@@ -1,0 +1,98 @@
+"""`nonsmooth manifolds`: the stable and unstable manifolds of a saddle periodic orbit (found
+first by Newton shooting, as `nonsmooth orbit`), their homoclinic points, and a figure over the
+basins."""
+
+from __future__ import annotations
+
+import math
+from typing import Annotated, Optional
+
+import typer
+
+from .analyses import V0Opt, X0Opt
+from .app import app
+from .common import (DEFAULT_MODEL, AtolOpt, ModelOpt, OutOpt, PlotOpt, PresetOpt, RtolOpt,
+                     SectionPhaseOpt, SetOpt, U0Opt, check_outputs, echo_written, load_params,
+                     preset_label, resolve_method, save_outputs)
+from .stability import EXIT_NOT_FOUND, OrbitMethodOpt, print_table
+
+
+@app.command("manifolds")
+def manifolds_cmd(
+    model: ModelOpt = DEFAULT_MODEL,
+    preset: PresetOpt = None,
+    set_: SetOpt = None,
+    k: Annotated[int, typer.Option("--k", help="period of the saddle in forcing periods")] = 1,
+    x0: X0Opt = -1.5,
+    v0: V0Opt = 0.25,
+    u0: U0Opt = None,
+    x: Annotated[tuple[float, float], typer.Option(
+        "--x", help="window of X the branches are grown in: MIN MAX")] = (-3.0, 3.0),
+    v: Annotated[tuple[float, float], typer.Option(
+        "--v", help="window of V: MIN MAX")] = (-3.0, 3.0),
+    spacing: Annotated[Optional[float], typer.Option(
+        "--spacing", help="largest distance between consecutive points (default: 1/200 of "
+                          "the window's diagonal)")] = None,
+    length: Annotated[Optional[float], typer.Option(
+        "--length", help="largest arc length of a branch (default: 4 window diagonals)")] = None,
+    stable: Annotated[bool, typer.Option(
+        "--stable/--no-stable", help="also the stable manifold (a search method)")] = True,
+    basins_grid: Annotated[int, typer.Option(
+        "--basins-grid", help="draw the figure over the basins on this grid (0: none)")] = 0,
+    method: OrbitMethodOpt = None,
+    rtol: RtolOpt = 1e-10,
+    atol: AtolOpt = 1e-12,
+    section_phase: SectionPhaseOpt = 0.0,
+    out: OutOpt = None,
+    plot: PlotOpt = None,
+):
+    """The stable and unstable manifolds of the saddle found from (x0, v0) by Newton shooting
+    (default: Fig. 7's saddle): both branches of each, grown in the window (--x, --v), their
+    homoclinic points, and a figure over the basins (--basins-grid). Exit status 1 when no
+    saddle was found from the start."""
+    from ..analysis.manifolds import BRANCH_NAMES, manifolds
+    from ..analysis.stability import periodic_orbit
+    from ..simulate import check_int
+
+    params = load_params(preset, set_, model, "fig7", method=method or "exact")
+    if method is None and "exact" in params.model.methods:
+        method = "exact"
+    method = resolve_method(params, method)
+    preset = preset_label(params, preset, "fig7")
+    check_int("k", k, 1)
+    grid = check_int("basins_grid", basins_grid, 0)
+    check_outputs(out, plot)
+    orbit = periodic_orbit(params, k=k, x0=x0, v0=v0, u0=u0, method=method, rtol=rtol,
+                           atol=atol, section_phase=section_phase)
+    if orbit.attrs["status"] != "converged":
+        typer.echo(f"error: manifolds: no period-{k} orbit found from (x0, v0) = ({x0:g}, "
+                   f"{v0:g}): {orbit.attrs['status']}; try another start (--x0, --v0, --u0)",
+                   err=True)
+        raise typer.Exit(EXIT_NOT_FOUND)
+    ds = manifolds(params, orbit, x=x, v=v, spacing=spacing, length=length, stable=stable)
+    bas = None
+    if plot is not None and grid:
+        from ..analysis.basins import basins
+        bas = basins(params, x=x, v=v, grid=grid, method=method, rtol=rtol, atol=atol,
+                     lyapunov=False)
+    from ..plot.manifolds import plot_manifolds
+    save_outputs(ds, preset, out, plot, lambda d: plot_manifolds(d, basins=bas))
+    mu = ds.multiplier_real.values
+    typer.echo(f"{preset} ({method}): saddle of period {k} at (X, V) = "
+               f"({float(ds.saddle_X):+.6g}, {float(ds.saddle_V):+.6g}), multipliers "
+               + ", ".join(f"{m:.6g}" for m in mu))
+    flag = ds.branch.values
+    rows = []
+    for b in range(ds.sizes["branch_index"]):
+        end = float(ds.end_X[b]), float(ds.end_V[b])
+        rows.append((BRANCH_NAMES[b], str(int((flag == b).sum())),
+                     ds.attrs[f"status_{BRANCH_NAMES[b]}"],
+                     f"({end[0]:+.5g}, {end[1]:+.5g})" if math.isfinite(end[0]) else "-"))
+    print_table(("branch", "points", "status", "end"), rows)
+    if stable:
+        n = ds.sizes["crossing"]
+        typer.echo(f"homoclinic points: {n}" + (
+            f" (smallest crossing angle {math.degrees(float(ds.crossing_angle.min())):.3g} deg)"
+            if n else ""))
+        typer.echo(f"stable manifold: {ds.attrs['stable_method']}")
+    echo_written(out, plot)

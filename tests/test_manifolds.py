@@ -1,0 +1,160 @@
+"""Stable and unstable manifolds of a saddle of the stroboscopic map, and the first homoclinic
+tangency along a parameter (``ns.manifolds``, ``ns.homoclinic_tangency``; issue 21, item 2).
+
+Oracles: invariance (a manifold point mapped by the kernel lands on its branch); at Fig. 7's
+omega = 1.10 the saddle's stable manifold is the boundary that ``basins`` computes (every
+manifold point in the grid has both labels within two cells, every boundary cell lies within
+2.5 cells of the manifold) and the unstable branches end on the two attractors; for the forced
+double well x'' + delta x' - x + x^3 = F cos t, Melnikov's first-order threshold of the first
+homoclinic tangency, F = delta 4 cosh(pi / 2) / (3 sqrt(2) pi)."""
+
+import math
+
+import numpy as np
+import pytest
+import xarray as xr
+
+import nonsmooth as ns
+from cli_helpers import one_line, run_cli
+from nonsmooth.errors import ParameterError
+from nonsmooth.io import load_dataset
+
+pytestmark = pytest.mark.filterwarnings("ignore::numba.NumbaExperimentalFeatureWarning")
+
+ATTRACTORS = [(-0.55703, 0.16048), (0.6567, 1.19366)]  # Fig. 7's two stable orbits
+WINDOW = dict(x=(-3.0, 3.0), v=(-3.0, 3.0))
+
+
+def _branch(ds, b):
+    sel = ds.branch.values == b
+    return np.c_[ds.X.values[sel], ds.V.values[sel]]
+
+
+def _distance_to(p, W):
+    """Distance from point p to the polyline W (rows)."""
+    a, b = W[:-1], W[1:]
+    d = b - a
+    t = np.clip(((p - a) * d).sum(1) / np.maximum((d * d).sum(1), 1e-300), 0.0, 1.0)
+    return float(np.min(np.linalg.norm(a + t[:, None] * d - p, axis=1)))
+
+
+@pytest.fixture(scope="module")
+def fig7():
+    p = ns.preset("fig7")
+    orbit = ns.periodic_orbit(p, x0=-1.5, v0=0.25)
+    return p, orbit, ns.manifolds(p, orbit, **WINDOW)
+
+
+def test_fig7_stable_manifold_is_the_basin_boundary_and_unstable_ends_on_the_attractors(fig7):
+    p, orbit, ds = fig7
+    a = ds.attrs
+    assert a["status_unstable_plus"] == a["status_unstable_minus"] == \
+        "converged onto an attractor"
+    assert a["status_stable_plus"] == a["status_stable_minus"] == "left the window"
+    assert a["map_periods"] == 1 and ds.sizes["crossing"] == 0  # a smooth boundary
+    ends = np.c_[ds.end_X.values[:2], ds.end_V.values[:2]]
+    near = [int(np.argmin([math.dist(e, att) for att in ATTRACTORS])) for e in ends]
+    assert sorted(near) == [0, 1]  # one branch onto each attractor
+    assert max(math.dist(e, ATTRACTORS[k]) for e, k in zip(ends, near)) < 0.01
+    b = ns.basins(p, grid=100, method="exact", lyapunov=False, **WINDOW)
+    lab = b.label.values
+    assert set(np.unique(lab)) == {0, 1}
+    x0, v0 = b.x0.values, b.v0.values
+    dx, dv = x0[1] - x0[0], v0[1] - v0[0]
+    W = np.concatenate([_branch(ds, 2), _branch(ds, 3)])
+    inside = (W[:, 0] >= x0[0]) & (W[:, 0] <= x0[-1]) & (W[:, 1] >= v0[0]) & (W[:, 1] <= v0[-1])
+    assert inside.sum() > 300
+    for x, v in W[inside]:
+        i, j = int(round((x - x0[0]) / dx)), int(round((v - v0[0]) / dv))
+        assert len(np.unique(lab[max(0, i - 2):i + 3, max(0, j - 2):j + 3])) == 2, (x, v)
+    edge = np.zeros(lab.shape, bool)
+    edge[:-1] |= lab[:-1] != lab[1:]
+    edge[1:] |= lab[:-1] != lab[1:]
+    edge[:, :-1] |= lab[:, :-1] != lab[:, 1:]
+    edge[:, 1:] |= lab[:, :-1] != lab[:, 1:]
+    I, J = np.nonzero(edge)
+    far = [min(np.hypot((W[:, 0] - x0[i]) / dx, (W[:, 1] - v0[j]) / dv)) for i, j in zip(I, J)]
+    assert len(I) > 300 and max(far) <= 2.5  # the whole boundary is the stable manifold
+
+
+@pytest.mark.parametrize("method", ["exact", "smooth"])
+def test_a_manifold_point_mapped_by_the_kernel_lands_on_its_branch(fig7, method):
+    p = ns.preset("fig7")
+    if method == "exact":
+        ds = fig7[2]
+    else:
+        orbit = ns.periodic_orbit(p, x0=-1.5, v0=0.25, method="smooth")
+        ds = ns.manifolds(p, orbit, spacing=0.06, length=6.0, **WINDOW)
+    spacing = ds.attrs["spacing"]
+    rng = np.random.default_rng(7)
+    for b in range(4):
+        W = _branch(ds, b)
+        assert len(W) > 60
+        steps = np.linalg.norm(np.diff(W, axis=0), axis=1)
+        assert steps.max() <= 1.1 * spacing  # (the corrector moves a stable point across)
+        for i in rng.choice(np.arange(1, len(W) - 20), 8, replace=False):
+            r = ns.simulate(p, periods=1, x0=W[i, 0], v0=W[i, 1], method=method,
+                            samples_per_period=16)
+            img = np.array([float(r.X[-1]), float(r.V[-1])])
+            # unstable: the image is a point of the branch (j + s -> j + 1 + s); stable: it
+            # lies between two points, within the chord's sagitta (curvature ~ 2)
+            assert _distance_to(img, W) <= (1e-7 if b < 2 else spacing ** 2 / 2), (b, i)
+
+
+def test_the_first_homoclinic_tangency_of_the_double_well_is_melnikovs():
+    m = ns.model_from_equations(
+        "double_well", states=("X", "V"), parameters={"delta": 0.05, "F0": 0.03, "omega": 1.0},
+        modes={"free": ["V", "-delta*V + X - X**3 + F0*cos(omega*t)"]}, method="smooth")
+    p = m.params()
+    orbit = ns.periodic_orbit(p, x0=-0.015, v0=0.0, method="smooth")
+    assert orbit.attrs["converged"] == 1 and float(orbit.multiplier_abs[0]) > 400
+    t = ns.homoclinic_tangency(p, orbit, "F0", (0.03, 0.045), tol=2e-4, x=(-2, 2),
+                               v=(-1.5, 1.5), length=5.0, spacing=0.05, max_search=60)
+    melnikov = 0.05 * 4 * math.cosh(math.pi / 2) / (3 * math.sqrt(2) * math.pi)  # 0.037651
+    assert abs(float(t.F0) / melnikov - 1.0) < 0.01
+    assert float(t.F0_above) - float(t.F0_below) <= 2e-4
+    assert t.sizes["crossing"] > 0 and t.n_crossings.values[0] == 0
+    assert t.attrs["analysis"] == "homoclinic_tangency" and t.attrs["param"] == "F0"
+    with pytest.raises(ParameterError, match="bounds: the manifolds do not cross"):
+        ns.homoclinic_tangency(p, orbit, "F0", (0.03, 0.032), x=(-2, 2), v=(-1.5, 1.5),
+                               length=5.0, spacing=0.05, max_search=60)
+
+
+def test_result_file_and_bad_input(fig7, tmp_path):
+    p, orbit, ds = fig7
+    path = tmp_path / "m.nc"
+    ns.io.save_dataset(ds, path)
+    got = load_dataset(path)
+    xr.testing.assert_equal(got, ds)
+    assert got.attrs["analysis"] == "manifolds" and got.attrs["method"] == "exact"
+    assert got.branch.attrs["flag_meanings"].split()[0] == "unstable_plus"
+    stable = ns.periodic_orbit(p, x0=0.0, v0=0.0, transient=300)
+    for call, field in [
+        (lambda: ns.manifolds(p, stable), "orbit: a saddle"),
+        (lambda: ns.manifolds(p, ds), "orbit: expected"),
+        (lambda: ns.manifolds(p.replace(omega=1.2), orbit), "orbit: computed at omega"),
+        (lambda: ns.manifolds(p, orbit, x=(1, 0), v=(0, 1)), "x: expected finite low < high"),
+        (lambda: ns.manifolds(p, orbit, x=(0, 1)), "x: give both"),
+        (lambda: ns.manifolds(p, orbit, spacing=0.0), "spacing: must be > 0"),
+        (lambda: ns.manifolds(p, orbit, iterates=0), "iterates"),
+        (lambda: ns.homoclinic_tangency(p, orbit, "omega", (1.1, 1.1)), "bounds"),
+    ]:
+        with pytest.raises(ParameterError, match=field):
+            call()
+
+
+def test_cli_manifolds_writes_the_api_result_and_a_figure(tmp_path, capsys, fig7):
+    nc, png = tmp_path / "m.nc", tmp_path / "m.png"
+    code, out, err = run_cli(["manifolds", "-o", str(nc), "--plot", str(png)], capsys)
+    assert code == 0, err
+    got = load_dataset(nc)
+    np.testing.assert_array_equal(got.X.values, fig7[2].X.values)
+    assert "saddle of period 1 at (X, V) = (-0.982138, +0.596784)" in out
+    assert "homoclinic points: 0" in out and out.count("converged onto an attractor") == 2
+    assert png.read_bytes()[:4] == b"\x89PNG"
+    code, out, err = run_cli(["manifolds", "--x0", "50", "--v0", "50"], capsys)
+    assert code == 1
+    one_line(err, "no period-1 orbit found")
+    code, out, err = run_cli(["manifolds", "--spacing", "-1"], capsys)
+    assert code == 2
+    one_line(err, "spacing")
