@@ -57,3 +57,76 @@ def test_fold_curve_bad_input(setup):
         ns.fold_curve(p, "a", "b", start=br, special=3)
     with pytest.raises(ParameterError, match="start:"):
         ns.fold_curve(p, "b", "a", start=br)  # a branch in a, not in b
+
+
+def test_fold_and_period_doubling_curves_of_the_bouncing_ball_are_its_closed_forms():
+    """The bouncing ball's period-one orbit folds at Gamma = A omega^2 / g = pi (1 - r)/(1 + r)
+    and flips at Gamma = hypot(pi (1 - r)/(1 + r), 2 (1 + r^2)/(1 + r)^2): both curves in
+    (A, r), continued both ways from r = 0.5 on the extended systems (section at phase pi: at
+    phase 0 the fold's impact falls on the section)."""
+    import math
+    m = ns.model("bouncing_ball")
+    W, R, psi = 2 * math.pi, 0.5, math.pi
+
+    def g_fold(r):
+        return math.pi * (1 - r) / (1 + r)
+
+    def g_flip(r):
+        return math.hypot(g_fold(r), 2 * (1 + r * r) / (1 + r) ** 2)
+
+    def on_orbit(gamma):
+        A, phi = gamma / W**2, math.acos(g_fold(R) / gamma)
+        s = (psi - phi) / W % 1.0
+        z0 = 0.5 * s - 0.5 * s * s + A * math.sin(phi) - A * math.sin(psi)
+        return m.params(A=A, r=R), z0, 0.5 - s - A * W * math.cos(psi)
+
+    for curve, gamma, direction, law, mu in (
+            (ns.fold_curve, 1.3, "down", g_fold, 1.0),
+            (ns.period_doubling_curve, 1.2, "up", g_flip, -1.0)):
+        p, z0, v0 = on_orbit(gamma)
+        lo, hi = 0.5 * g_fold(R) / W**2, (g_flip(R) + 0.2) / W**2
+        br = ns.continuation(p, "A", x0=z0, v0=v0, direction=direction, bounds=(lo, hi),
+                             section_phase=psi)
+        for way in ("up", "down"):
+            c = curve(p, "A", "r", start=br, direction=way, step=0.02, bounds2=(0.3, 0.7))
+            assert c.attrs["status"] == "left the bounds of r" and c.sizes["cusp"] == 0
+            r = c.r.values
+            assert (r.max() > 0.69) if way == "up" else (r.min() < 0.31)
+            err = [abs(a * W**2 - law(rr)) for a, rr in zip(c.A.values, r)]
+            assert max(err) < 1e-8
+            assert np.max(np.abs(c.multiplier_real.values[:, 0] - mu)) < 1e-7
+            assert c.attrs["section_phase"] == psi
+    with pytest.raises(ParameterError, match="no period doubling"):
+        ns.period_doubling_curve(p, "A", "r", start=ns.continuation(
+            p, "A", x0=z0, v0=v0, bounds=(1.2 / W**2, 1.3 / W**2), section_phase=psi))
+
+
+def test_cli_continues_the_fig6a_fold_as_an_extended_system(tmp_path, capsys):
+    """``nonsmooth continue --two-param omega_s --extended up``: Fig. 6a's upper fold omega_c
+    rises with the support's stiffness; at omega_s = 5 it is where ``two_parameter_curve``
+    re-locates it (1.264323)."""
+    from cli_helpers import one_line, run_cli
+    from nonsmooth.io import load_dataset
+    nc, png = tmp_path / "f.nc", tmp_path / "f.png"
+    args = ["continue", "--param", "omega", "--set", "omega=0.5", "--bounds", "0.5", "1.6",
+            "--two-param", "omega_s", "--step", "0.02"]
+    code, out, err = run_cli(args + ["--extended", "up", "--bounds2", "1", "5.5", "-o", str(nc),
+                                     "--plot", str(png)], capsys)
+    assert code == 0, err
+    ds = load_dataset(nc)
+    assert ds.attrs["analysis"] == "fold_curve" and ds.attrs["status"] == \
+        "left the bounds of omega_s"
+    assert "fold of the period-1 branch at omega = 1.1930415" in out
+    w, ws = ds.omega.values, ds.omega_s.values
+    assert np.all(np.diff(ws) > 0)
+    assert abs(np.interp(5.0, ws, w) - 1.264323) < 2e-4  # linear interpolation, steps 0.02
+    assert np.max(np.abs(ds.multiplier_real.values[:, 0] - 1.0)) < 1e-7
+    assert png.read_bytes()[:4] == b"\x89PNG"
+    for extra, needle in ((["--extended", "sideways"], "extended"),
+                          (["--extended", "up", "--special", "grazing"], "special")):
+        code, out, err = run_cli(args + extra + ["-o", str(nc)], capsys)
+        assert code == 2
+        one_line(err, needle)
+    code, out, err = run_cli(args[:-4] + ["--extended", "up", "-o", str(nc)], capsys)
+    assert code == 2
+    one_line(err, "--two-param")

@@ -1,7 +1,9 @@
-"""A fold of periodic orbits continued in two parameters as one extended system, through its
-turning points, with its cusps located (issue 21, item 4, for folds).
+"""A fold (or a period doubling) of periodic orbits continued in two parameters as one
+extended system, through its turning points, with the cusps of a fold curve located (issue 21,
+item 4).
 
 ``fold_curve(params, "omega", "omega_s", start=branch) -> xarray.Dataset``
+``period_doubling_curve(params, "omega", "F0", start=branch) -> xarray.Dataset``
 
 The unknowns are the section point z of a k-periodic orbit and the two parameters (l1, l2);
 the equations are the orbit condition and the fold condition,
@@ -20,7 +22,8 @@ them vanishes: there the curve's projection on (l1, l2) reverses, both parameter
 its tangent changing sign within one step. A cusp is reported at the zero of the parameter
 speed, interpolated between the two points that bracket it.
 
-The fold condition det(M - I) = 0 also holds at a multiplier 1 that is not a fold (a
+A period doubling is followed on the same system with the flip condition det(M + I) = 0 in
+place of the fold's. The fold condition det(M - I) = 0 also holds at a multiplier 1 that is not a fold (a
 transcritical or pitchfork point): the curve follows whatever has a multiplier 1.
 """
 
@@ -46,8 +49,10 @@ from .stability import _active, _section_state
 class _FoldBranch:
     """The extended system at parameter indices (i1, i2): coordinates y = (z, l2), then l1."""
 
-    def __init__(self, setup: TangentSetup, p0, i1: int, i2: int, k: int, tol: float):
+    def __init__(self, setup: TangentSetup, p0, i1: int, i2: int, k: int, tol: float,
+                 mu: float = 1.0):
         self.setup, self.p0, self.i1, self.i2, self.k, self.tol = setup, p0, i1, i2, k, tol
+        self.mu = mu  # the critical multiplier: 1 (fold), -1 (period doubling)
         self.N = setup.N + 1
         self.template = None
 
@@ -66,7 +71,7 @@ class _FoldBranch:
             return None
         act = _active(M, self.setup.n)
         Ma = M[np.ix_(act, act)]
-        g = float(np.linalg.det(Ma - np.eye(len(Ma))))
+        g = float(np.linalg.det(Ma - self.mu * np.eye(len(Ma))))
         return self.setup.z_of(s1) - z, M, g, s0
 
     def _ends(self, z, l1, l2, s0):
@@ -77,7 +82,8 @@ class _FoldBranch:
         return self.setup.z_of(s)
 
     def evaluate(self, w, l1):
-        """(G, J, None, start state, M): G = (P - z, g) at (z, l2) = w and l1, J its Jacobian
+        """(G, J, None, start state, M): G = (P - z, g) at (z, l2) = w and l1 (g =
+        det(M - mu I)), J its Jacobian
         in (z, l2, l1) ((N + 1) x (N + 2)); None when a trajectory fails."""
         Nz = self.setup.N
         z, l2 = w[:Nz], float(w[Nz])
@@ -94,7 +100,7 @@ class _FoldBranch:
             if hi is None or lo is None:
                 return None
             J[:Nz, col] = (hi - lo) / (2.0 * h)
-        for j in range(Nz + 2):  # dg: forward differences of det(M - I)
+        for j in range(Nz + 2):  # dg: forward differences of det(M - mu I)
             h = 1e-6 * max(1.0, abs(z[j]) if j < Nz else abs(l2 if j == Nz else l1))
             zz = z.copy()
             ll1, ll2 = l1, l2
@@ -175,14 +181,34 @@ def fold_curve(params, param: str, param2: str, *, start, special: int | None = 
     value of ``param2`` in ``params``, ``direction`` "up" (``param2`` increasing at first) or
     "down", with arclength steps from ``step`` (adapted up to ``max_step``, default 10 x) until
     ``param`` leaves ``bounds`` or ``param2`` leaves ``bounds2`` (default: unbounded),
-    ``max_points`` or the corrector fails.
+    ``max_points`` or the corrector fails. The branch's section phase is kept.
 
     Returns a Dataset over ``point``: ``<param>``, ``<param2>``, the section point
     (``X_section``, ``V_section``, ...), the multipliers (``multiplier_real/imag/abs``, one of
     them 1 on the curve), and over ``cusp`` the located cusps (``cusp_<param>``,
     ``cusp_<param2>``, ``cusp_after_point``); attrs ``status``."""
+    return _special_curve(FOLD, params, param, param2, start, special, direction, step,
+                          max_step, bounds, bounds2, max_points, tol, rtol, atol)
+
+
+def period_doubling_curve(params, param: str, param2: str, *, start,
+                          special: int | None = None, direction: str = "up", step: float = 0.01,
+                          max_step: float | None = None, bounds=None, bounds2=None,
+                          max_points: int = 300, tol: float = 1e-9, rtol: float = 1e-10,
+                          atol: float = 1e-12) -> xr.Dataset:
+    """A period doubling (flip) of ``start``'s branch continued in (``param``, ``param2``):
+    as :func:`fold_curve` with the flip condition det(M + I) = 0 (a multiplier -1) in place of
+    the fold's. The same arguments and Dataset (``cusp`` empty: cusps are meetings of folds;
+    the multiplier -1 is in ``multiplier_real``)."""
+    return _special_curve(PERIOD_DOUBLING, params, param, param2, start, special, direction,
+                          step, max_step, bounds, bounds2, max_points, tol, rtol, atol)
+
+
+def _special_curve(kind, params, param, param2, start, special, direction, step, max_step,
+                   bounds, bounds2, max_points, tol, rtol, atol):
     from ..kernels import Solver
     from ..simulate import check_params
+    what = {FOLD: "fold", PERIOD_DOUBLING: "period doubling"}[kind]
     params = check_params(params)
     m = params.model
     p1, p2 = m.param(param).name, m.param(param2).name
@@ -191,17 +217,17 @@ def fold_curve(params, param: str, param2: str, *, start, special: int | None = 
     if not isinstance(start, xr.Dataset) or "special_type" not in start or \
             start.attrs.get("param") != p1:
         raise ParameterError(f"start: expected the Dataset of continuation(..., {p1!r}, ...) "
-                             f"with a fold")
+                             f"with a {what}")
     if start.attrs.get("model") != m.name:
         raise ParameterError(f"start: a branch of model {start.attrs.get('model')}, not {m.name}")
-    folds = np.flatnonzero(start.special_type.values == FOLD)
+    found = np.flatnonzero(start.special_type.values == kind)
     if special is None:
-        if folds.size == 0:
-            raise ParameterError("start: the branch has no fold")
-        special = int(folds[0])
-    elif not (0 <= special < start.sizes["special"]) or start.special_type.values[special] != FOLD:
-        raise ParameterError(f"special: {special!r} is not a fold of the branch (folds: "
-                             f"{folds.tolist()})")
+        if found.size == 0:
+            raise ParameterError(f"start: the branch has no {what}")
+        special = int(found[0])
+    elif not (0 <= special < start.sizes["special"]) or start.special_type.values[special] != kind:
+        raise ParameterError(f"special: {special!r} is not a {what} of the branch ({what}s: "
+                             f"{found.tolist()})")
     if "section_moved" in start.attrs or "section" in start.attrs:
         raise ParameterError("start: a branch whose section moved, or of limit cycles, is not "
                              "supported here")
@@ -212,26 +238,28 @@ def fold_curve(params, param: str, param2: str, *, start, special: int | None = 
                                                                                   math.inf)
     k = int(start.attrs.get("k", 1))
     method = str(start.attrs.get("method", "exact"))
-    solver = Solver(method=method, rtol=rtol, atol=atol, model=m)
+    solver = Solver(method=method, rtol=rtol, atol=atol, model=m,
+                    section_phase=float(start.attrs.get("section_phase", 0.0)))
     setup = TangentSetup(solver)
     l1 = float(start[f"special_{p1}"].values[special])
     l2 = float(getattr(params, p2))
     params = params.replace(**{p1: l1})
     p0 = params.pack()
-    br = _FoldBranch(setup, p0, m.index[p1], m.index[p2], k, tol)
+    br = _FoldBranch(setup, p0, m.index[p1], m.index[p2], k, tol,
+                     mu=1.0 if kind == FOLD else -1.0)
     Nz = setup.N
     z0 = np.zeros(Nz)
     zc = np.asarray(components(start, "special_", "_section").values[special], dtype=float)
     z0[:len(zc)] = zc  # (continuous memory, if any, starts from 0 and is mapped at once)
     br.template = new_state(0.0, 0.0)  # mode -1: classified at each point
-    # the fold from the branch, refined on the extended system at fixed l2 (a step of zero
+    # the point from the branch, refined on the extended system at fixed l2 (a step of zero
     # length along l2)
     t = np.zeros(Nz + 2)
     t[Nz] = 1.0
     y = np.r_[z0, l2, l1]
     got = br.correct(y, t)
     if got is None:
-        raise ParameterError(f"start: the fold at {p1} = {l1:g} does not converge on the "
+        raise ParameterError(f"start: the {what} at {p1} = {l1:g} does not converge on the "
                              f"extended system")
     y, ev, _ = got
     sign = 1.0 if direction == "up" else -1.0
@@ -246,11 +274,12 @@ def fold_curve(params, param: str, param2: str, *, start, special: int | None = 
     if out2.size:
         pts = pts[:out2[0] + 1]
         status = f"left the bounds of {p2}"
-    cusps = _cusps(pts, Nz + 1)
-    return _dataset(params, solver, p1, p2, k, pts, cusps, status, Nz)
+    cusps = _cusps(pts, Nz + 1) if kind == FOLD else []
+    return _dataset(params, solver, p1, p2, k, pts, cusps, status, Nz,
+                    "fold_curve" if kind == FOLD else "period_doubling_curve")
 
 
-def _dataset(params, solver, p1, p2, k, pts, cusps, status, Nz):
+def _dataset(params, solver, p1, p2, k, pts, cusps, status, Nz, analysis):
     m = params.model
     ys = np.array([y for y, _ in pts])
     mu = np.array([f["mu"] for _, f in pts])
@@ -274,7 +303,7 @@ def _dataset(params, solver, p1, p2, k, pts, cusps, status, Nz):
         },
         coords={"point": np.arange(len(pts)), "multiplier": np.arange(1, mu.shape[1] + 1),
                 "cusp": np.arange(len(cusps))},
-        attrs=provenance_attrs(params, solver, swept=(p1, p2), analysis="fold_curve",
+        attrs=provenance_attrs(params, solver, swept=(p1, p2), analysis=analysis,
                                param=p1, param2=p2, k=k, status=status, n_cusps=len(cusps)),
     )
     ds.update(component_variables(m, ("point",), U, suffix="_section",

@@ -91,6 +91,15 @@ def continue_cmd(
     crossing: Annotated[str, typer.Option(
         "--crossing", help="with --section: the crossings counted, decreasing, increasing "
                            "or both")] = "decreasing",
+    extended: Annotated[Optional[str], typer.Option(
+        "--extended", show_default=False,
+        help="with --two-param and --special fold or period_doubling: continue the branch's "
+             "first such point as one extended system in (--param, --two-param), through "
+             "turning points and cusps, with --two-param going up or down at first (no "
+             "--values)")] = None,
+    bounds2: Annotated[Optional[tuple[float, float]], typer.Option(
+        "--bounds2", show_default=False,
+        help="with --extended: stop when --two-param leaves LO HI")] = None,
     max_time: MaxTimeOpt = 1e4,
     out: OutOpt = None,
     plot: PlotOpt = None,
@@ -126,6 +135,10 @@ def continue_cmd(
                              f"{param} = {lam0:g} (set it with --set {param}=VALUE)")
     cycles = section is not None or params.model.autonomous
     sec = (section or "V", crossing) if cycles else None
+    if extended is not None:
+        return _extended(params, preset, param, two_param, special, extended, bounds2, k, x0,
+                         v0, u0, transient, direction, step, max_step, bounds, max_points,
+                         method, tol, rtol, atol, section_phase, sec, max_time, out, plot)
     if two_param is not None:
         return _two_parameter(params, preset, param, two_param, values, special, k, x0, v0,
                               step, bounds, max_points, method, tol, out, plot, section_phase,
@@ -193,4 +206,46 @@ def _two_parameter(params, preset, param, param2, values, special, k, x0, v0, st
     print_table((param2, *[f"{param} #{j}" for j in range(ds.sizes['n'])]),
                 [(f"{v:.6g}", *[("-" if not np.isfinite(x) else f"{x:.8f}") for x in row])
                  for v, row in zip(ds[param2].values, ds[param].values)])
+    echo_written(out, plot)
+
+
+def _extended(params, preset, param, param2, special, way, bounds2, k, x0, v0, u0, transient,
+              direction, step, max_step, bounds, max_points, method, tol, rtol, atol,
+              section_phase, sec, max_time, out, plot):
+    """``nonsmooth continue --two-param P2 --extended up|down``: the branch's first fold (or
+    period doubling) continued as an extended system (``fold_curve``,
+    ``period_doubling_curve``)."""
+    from ..analysis.continuation import continuation
+    from ..analysis.fold_curve import fold_curve, period_doubling_curve
+    from ..plot.continuation import plot_special_curve
+
+    if param2 is None:
+        raise ParameterError("extended: --extended needs --two-param (the second parameter)")
+    if way not in ("up", "down"):
+        raise ParameterError(f"extended: expected 'up' or 'down', got {way!r}")
+    curves = {"fold": fold_curve, "period_doubling": period_doubling_curve}
+    if special not in curves:
+        raise ParameterError(f"special: --extended follows fold or period_doubling, got "
+                             f"{special!r}")
+    if sec is not None:
+        raise ParameterError("extended: limit cycles on a section are not supported here")
+    p2 = params.model.param(param2).name
+    check_outputs(out, plot)
+    br = continuation(params, param, k=k, x0=x0, v0=v0, u0=u0, transient=transient,
+                      direction=direction, step=step, max_step=max_step, bounds=bounds,
+                      max_points=max_points, method=method, tol=tol, rtol=rtol, atol=atol,
+                      section_phase=section_phase, max_time=max_time)
+    ds = curves[special](params, param, p2, start=br, direction=way, step=step,
+                         max_step=max_step, bounds=bounds, bounds2=bounds2,
+                         max_points=max_points, tol=max(tol, 1e-9), rtol=rtol, atol=atol)
+    save_outputs(ds, preset, out, plot, plot_special_curve)
+    a, b = ds[param].values, ds[p2].values
+    typer.echo(f"{preset} ({method}): {special.replace('_', ' ')} of the period-{k} branch at "
+               f"{param} = {a[0]:.8g}, {p2} = {b[0]:.8g}, continued in ({param}, {p2}): "
+               f"{a.size} points, {p2} from {b.min():.6g} to {b.max():.6g}, {param} from "
+               f"{a.min():.6g} to {a.max():.6g}")
+    typer.echo(f"status: {ds.attrs['status']}")
+    for i in range(ds.sizes["cusp"]):
+        typer.echo(f"cusp at {param} = {float(ds['cusp_' + param][i]):.8g}, {p2} = "
+                   f"{float(ds['cusp_' + p2][i]):.8g}")
     echo_written(out, plot)

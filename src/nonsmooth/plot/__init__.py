@@ -39,6 +39,7 @@ _PLOTS = {
     "plot_orbit": ".stability",
     "plot_continuation": ".continuation",
     "plot_two_parameter": ".continuation",
+    "plot_special_curve": ".continuation",
     "plot_parameter_map": ".parameter_map",
     "plot_lambda1_map": ".parameter_map",
 }

@@ -241,3 +241,30 @@ def plot_two_parameter(ds, ax=None):
     ax.legend(fontsize=8)
     fig.tight_layout()
     return fig
+
+
+def plot_special_curve(ds, ax=None):
+    """A fold or period-doubling curve continued as an extended system
+    (``fold_curve``, ``period_doubling_curve``): the first parameter versus the second, its
+    start (o) and its cusps (x)."""
+    param, param2 = ds.attrs["param"], ds.attrs["param2"]
+    if ax is None:
+        fig, ax = new_figure(figsize=(7, 5))
+    else:
+        fig = ax.figure
+    m = model_of(ds)
+    what = "fold" if ds.attrs.get("analysis") == "fold_curve" else "period doubling"
+    ax.plot(ds[param].values, ds[param2].values, "-", color="k", lw=1.3, label=f"{what} curve")
+    ax.plot(ds[param].values[0], ds[param2].values[0], "o", mfc="none", mec="k",
+            label="start (on the branch)")
+    if ds.sizes.get("cusp", 0):
+        ax.plot(ds["cusp_" + param].values, ds["cusp_" + param2].values, "x", color="tab:red",
+                ms=10, mew=2, label="cusp")
+    ax.set_xlabel(f"{param_symbol(m, param)} [{ds[param].attrs.get('units', '')}]")
+    ax.set_ylabel(f"{param_symbol(m, param2)} [{ds[param2].attrs.get('units', '')}]")
+    ax.set_title(f"{what} continued in ({param}, {param2}): {ds.attrs.get('status', '')}",
+                 fontsize=10)
+    ax.grid(True, lw=0.3, alpha=0.5)
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    return fig
