@@ -123,10 +123,36 @@ def test_cli_continues_the_fig6a_fold_as_an_extended_system(tmp_path, capsys):
     assert np.max(np.abs(ds.multiplier_real.values[:, 0] - 1.0)) < 1e-7
     assert png.read_bytes()[:4] == b"\x89PNG"
     for extra, needle in ((["--extended", "sideways"], "extended"),
-                          (["--extended", "up", "--special", "grazing"], "special")):
+                          (["--extended", "up", "--special", "neimark_sacker"], "special")):
         code, out, err = run_cli(args + extra + ["-o", str(nc)], capsys)
         assert code == 2
         one_line(err, needle)
     code, out, err = run_cli(args[:-4] + ["--extended", "up", "-o", str(nc)], capsys)
     assert code == 2
     one_line(err, "--two-param")
+
+
+def test_the_grazing_curve_of_the_contact_free_orbit_is_its_closed_form():
+    """Fig. 6a's contact-free orbit X'' + xi X' + X = F0 cos(omega t) grazes the support
+    (X = 1) where its amplitude is 1: F0 = sqrt((1 - omega^2)^2 + (xi omega)^2). The grazing
+    that continuation locates at omega_a = 0.9403, continued both ways in (omega, F0)."""
+    p = ns.preset("fig6a").replace(omega=0.5)
+    br = ns.continuation(p, "omega", bounds=(0.5, 1.6), method="exact")
+    assert br.special_type.values[0] == 4  # grazing first
+    for way in ("up", "down"):
+        c = ns.grazing_curve(p, "omega", "F0", start=br, direction=way, step=0.02,
+                             bounds2=(0.05, 0.5), bounds=(0.3, 1.6))
+        assert c.attrs["status"] == "left the bounds of F0"
+        assert c.attrs["analysis"] == "grazing_curve" and c.sizes["point"] > 10
+        w, F = c.omega.values, c.F0.values
+        assert np.max(np.abs(F - np.sqrt((1 - w**2) ** 2 + (p.xi * w) ** 2))) < 1e-10
+        assert np.max(np.abs(c.max_X.values - 1.0)) < 1e-10
+        assert (F.max() > 0.5) if way == "up" else (F.min() < 0.05)
+    m = ns.model_from_equations("no_contact", states=("X", "V"),
+                                parameters={"a": 0.1, "omega": 1.0},
+                                modes={"free": ["V", "-X - a*V + cos(omega*t)"]}, method="smooth")
+    q = m.params()
+    fake = br.copy()
+    fake.attrs.update(model="no_contact", method="smooth")
+    with pytest.raises(ParameterError, match="start: expected|contact level|no grazing"):
+        ns.grazing_curve(q, "omega", "a", start=fake)

@@ -4,6 +4,7 @@ item 4).
 
 ``fold_curve(params, "omega", "omega_s", start=branch) -> xarray.Dataset``
 ``period_doubling_curve(params, "omega", "F0", start=branch) -> xarray.Dataset``
+``grazing_curve(params, "omega", "F0", start=branch) -> xarray.Dataset``
 
 The unknowns are the section point z of a k-periodic orbit and the two parameters (l1, l2);
 the equations are the orbit condition and the fold condition,
@@ -23,7 +24,7 @@ its tangent changing sign within one step. A cusp is reported at the zero of the
 speed, interpolated between the two points that bracket it.
 
 A period doubling is followed on the same system with the flip condition det(M + I) = 0 in
-place of the fold's. The fold condition det(M - I) = 0 also holds at a multiplier 1 that is not a fold (a
+place of the fold's, a grazing with max X - contact level = 0. The fold condition det(M - I) = 0 also holds at a multiplier 1 that is not a fold (a
 transcritical or pitchfork point): the curve follows whatever has a multiplier 1.
 """
 
@@ -152,6 +153,24 @@ class _FoldBranch:
                                               NEIMARK_SACKER: math.nan, GRAZING: math.nan})
 
 
+class _GrazingBranch(_FoldBranch):
+    """The extended system of a grazing: the orbit condition and g = max X over the orbit
+    (its interior extrema, located by the kernel) - the model's contact level."""
+
+    def __init__(self, setup, p0, i1, i2, k, tol, level):
+        super().__init__(setup, p0, i1, i2, k, tol)
+        self.level = level  # (l1, l2) -> the contact level there
+
+    def _map(self, z, l1, l2):
+        p = self.p(l1, l2)
+        s0 = _section_state(self.setup, p, z, self.template)
+        s1, M, code, bufs = period_map(self.setup, p, s0, self.k)
+        if code != st.OK:
+            return None
+        g = float(np.max(bufs[4])) - self.level(l1, l2)
+        return self.setup.z_of(s1) - z, M, g, s0
+
+
 def _cusps(pts, N):
     """(l1, l2, index) of each cusp: the curve's velocity in (l1, l2) (the parameter part of
     its unit tangent) turns by more than a right angle between points i and i + 1 (at a cusp
@@ -204,11 +223,25 @@ def period_doubling_curve(params, param: str, param2: str, *, start,
                           step, max_step, bounds, bounds2, max_points, tol, rtol, atol)
 
 
+def grazing_curve(params, param: str, param2: str, *, start, special: int | None = None,
+                  direction: str = "up", step: float = 0.01, max_step: float | None = None,
+                  bounds=None, bounds2=None, max_points: int = 300, tol: float = 1e-9,
+                  rtol: float = 1e-10, atol: float = 1e-12) -> xr.Dataset:
+    """A grazing of ``start``'s branch (the orbit's largest X reaches the model's contact
+    level, ``Model.contact_level``) continued in (``param``, ``param2``): as :func:`fold_curve`
+    with the grazing condition max X - level = 0 (max X over the orbit, interior extrema
+    located by the kernel; its derivatives by forward differences, taken on whichever side of
+    the contact they fall) in place of the fold's. The same arguments and Dataset (``cusp``
+    empty; ``max_X`` per point)."""
+    return _special_curve(GRAZING, params, param, param2, start, special, direction, step,
+                          max_step, bounds, bounds2, max_points, tol, rtol, atol)
+
+
 def _special_curve(kind, params, param, param2, start, special, direction, step, max_step,
                    bounds, bounds2, max_points, tol, rtol, atol):
     from ..kernels import Solver
     from ..simulate import check_params
-    what = {FOLD: "fold", PERIOD_DOUBLING: "period doubling"}[kind]
+    what = {FOLD: "fold", PERIOD_DOUBLING: "period doubling", GRAZING: "grazing"}[kind]
     params = check_params(params)
     m = params.model
     p1, p2 = m.param(param).name, m.param(param2).name
@@ -245,8 +278,18 @@ def _special_curve(kind, params, param, param2, start, special, direction, step,
     l2 = float(getattr(params, p2))
     params = params.replace(**{p1: l1})
     p0 = params.pack()
-    br = _FoldBranch(setup, p0, m.index[p1], m.index[p2], k, tol,
-                     mu=1.0 if kind == FOLD else -1.0)
+    if kind == GRAZING:
+        if m.contact_level is None:
+            raise ParameterError(f"start: model {m.name} declares no contact level "
+                                 f"(Model.contact_level): no grazing to follow")
+        base = params
+
+        def level(a, b):
+            return float(m.contact_level(base.replace(**{p1: a, p2: b})))
+        br = _GrazingBranch(setup, p0, m.index[p1], m.index[p2], k, tol, level)
+    else:
+        br = _FoldBranch(setup, p0, m.index[p1], m.index[p2], k, tol,
+                         mu=1.0 if kind == FOLD else -1.0)
     Nz = setup.N
     z0 = np.zeros(Nz)
     zc = np.asarray(components(start, "special_", "_section").values[special], dtype=float)
@@ -275,8 +318,14 @@ def _special_curve(kind, params, param, param2, start, special, direction, step,
         pts = pts[:out2[0] + 1]
         status = f"left the bounds of {p2}"
     cusps = _cusps(pts, Nz + 1) if kind == FOLD else []
-    return _dataset(params, solver, p1, p2, k, pts, cusps, status, Nz,
-                    "fold_curve" if kind == FOLD else "period_doubling_curve")
+    ds = _dataset(params, solver, p1, p2, k, pts, cusps, status, Nz,
+                  {FOLD: "fold_curve", PERIOD_DOUBLING: "period_doubling_curve",
+                   GRAZING: "grazing_curve"}[kind])
+    if kind == GRAZING:  # max X on the curve: the contact level there, to the tolerance
+        ds["max_X"] = ("point", np.array([br.level(y[Nz + 1], y[Nz]) + br._map(
+            y[:Nz], y[Nz + 1], y[Nz])[2] for y, _ in pts]), {
+                "long_name": "largest X over the orbit (interior extrema included)"})
+    return ds
 
 
 def _dataset(params, solver, p1, p2, k, pts, cusps, status, Nz, analysis):

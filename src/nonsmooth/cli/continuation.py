@@ -93,8 +93,8 @@ def continue_cmd(
                            "or both")] = "decreasing",
     extended: Annotated[Optional[str], typer.Option(
         "--extended", show_default=False,
-        help="with --two-param and --special fold or period_doubling: continue the branch's "
-             "first such point as one extended system in (--param, --two-param), through "
+        help="with --two-param and --special fold, period_doubling or grazing: continue the "
+             "branch's first such point as one extended system in (--param, --two-param), through "
              "turning points and cusps, with --two-param going up or down at first (no "
              "--values)")] = None,
     bounds2: Annotated[Optional[tuple[float, float]], typer.Option(
@@ -213,20 +213,21 @@ def _extended(params, preset, param, param2, special, way, bounds2, k, x0, v0, u
               direction, step, max_step, bounds, max_points, method, tol, rtol, atol,
               section_phase, sec, max_time, out, plot):
     """``nonsmooth continue --two-param P2 --extended up|down``: the branch's first fold (or
-    period doubling) continued as an extended system (``fold_curve``,
-    ``period_doubling_curve``)."""
+    period doubling, or grazing) continued as an extended system (``fold_curve``,
+    ``period_doubling_curve``, ``grazing_curve``)."""
     from ..analysis.continuation import continuation
-    from ..analysis.fold_curve import fold_curve, period_doubling_curve
+    from ..analysis.fold_curve import fold_curve, grazing_curve, period_doubling_curve
     from ..plot.continuation import plot_special_curve
 
     if param2 is None:
         raise ParameterError("extended: --extended needs --two-param (the second parameter)")
     if way not in ("up", "down"):
         raise ParameterError(f"extended: expected 'up' or 'down', got {way!r}")
-    curves = {"fold": fold_curve, "period_doubling": period_doubling_curve}
+    curves = {"fold": fold_curve, "period_doubling": period_doubling_curve,
+              "grazing": grazing_curve}
     if special not in curves:
-        raise ParameterError(f"special: --extended follows fold or period_doubling, got "
-                             f"{special!r}")
+        raise ParameterError(f"special: --extended follows fold, period_doubling or grazing, "
+                             f"got {special!r}")
     if sec is not None:
         raise ParameterError("extended: limit cycles on a section are not supported here")
     p2 = params.model.param(param2).name

@@ -244,8 +244,8 @@ def plot_two_parameter(ds, ax=None):
 
 
 def plot_special_curve(ds, ax=None):
-    """A fold or period-doubling curve continued as an extended system
-    (``fold_curve``, ``period_doubling_curve``): the first parameter versus the second, its
+    """A fold, period-doubling or grazing curve continued as an extended system
+    (``fold_curve``, ``period_doubling_curve``, ``grazing_curve``): the first parameter versus the second, its
     start (o) and its cusps (x)."""
     param, param2 = ds.attrs["param"], ds.attrs["param2"]
     if ax is None:
@@ -253,7 +253,8 @@ def plot_special_curve(ds, ax=None):
     else:
         fig = ax.figure
     m = model_of(ds)
-    what = "fold" if ds.attrs.get("analysis") == "fold_curve" else "period doubling"
+    what = {"fold_curve": "fold", "period_doubling_curve": "period doubling",
+            "grazing_curve": "grazing"}.get(ds.attrs.get("analysis"), "special point")
     ax.plot(ds[param].values, ds[param2].values, "-", color="k", lw=1.3, label=f"{what} curve")
     ax.plot(ds[param].values[0], ds[param2].values[0], "o", mfc="none", mec="k",
             label="start (on the branch)")
