@@ -2,6 +2,7 @@
 models written by hand, closed forms derived for linear modes, any periodic forcing through
 the period's local time, tangent dynamics, and one-line errors for bad equations."""
 
+import inspect
 import math
 
 import numpy as np
@@ -219,6 +220,10 @@ def test_a_model_names_its_forcing_period():
     with pytest.raises(ParameterError, match="not both"):
         ns.model_from_equations("bad", states=("X", "V"), parameters={"T": 1.0, "w": 1.0},
                                 modes={"free": ["V", "-X"]}, period="T", omega="w")
+    with pytest.raises(ParameterError, match="not both"):  # "omega" given, not the default
+        ns.model_from_equations("bad", states=("X", "V"),
+                                parameters={"T": 1.0, "omega": 1.0},
+                                modes={"free": ["V", "-X"]}, period="T", omega="omega")
 
 
 @pytest.mark.parametrize("change, needle", [
@@ -262,6 +267,29 @@ def test_a_model_file_of_equations_runs_from_the_cli(tmp_path):
     assert r.returncode == 0, r.stderr
     ds = ns.io.load_dataset(tmp_path / "p.nc")
     assert int(ds.period) == 1 and ds.attrs["model"] == "impact_eq"
+
+
+def test_default_ranges_of_a_period_model_are_periods(tmp_path, capsys):
+    """The default sweeps of a model with a forcing period are the frequency defaults as
+    periods: parameter_map's x axis and the CLI's --from/--to (bifurcation: omega 0.8 ... 1.0,
+    so T = 2 pi / 1.0 ... 2 pi / 0.8)."""
+    from cli_helpers import run_cli
+    from nonsmooth.io import load_dataset
+    m = square_wave()
+    assert m.forcing_range(0.8, 1.0) == pytest.approx((2 * math.pi, 2.5 * math.pi))
+    assert ns.model("support").forcing_range(0.8, 1.0) == (0.8, 1.0)
+    d = ns.parameter_map(m.params(), y=("F0", 0.1, 0.4, 1), transient=5, record=2,
+                         method="exact", lyapunov=False)
+    np.testing.assert_allclose(d["T"].values[[0, -1]], [2 * math.pi, 2.5 * math.pi])
+    path = tmp_path / "sq.py"
+    path.write_text("import nonsmooth as ns\n\n\n" + inspect.getsource(square_wave)
+                    + "\nMODEL = square_wave()\n")
+    nc = tmp_path / "b.nc"
+    code, out, err = run_cli(["bifurcation", "--model", f"{path}:MODEL", "--steps", "3",
+                              "--record", "2", "--transient", "5", "-o", str(nc)], capsys)
+    assert code == 0, err
+    np.testing.assert_allclose(load_dataset(nc)["T"].values[[0, -1]],
+                               [2 * math.pi, 2.5 * math.pi])
 
 
 def test_a_self_excited_cycle_is_the_same_with_a_period_parameter():

@@ -104,7 +104,7 @@ def _map_chunk(spec, i, carry, workers=None, progress=None):
             for k in names}
 
 
-def parameter_map(params: ParamsBase, x=("omega", 0.8, 1.0, 100), y=("F0", 0.15, 0.45, 100), *,
+def parameter_map(params: ParamsBase, x=None, y=("F0", 0.15, 0.45, 100), *,
                   transient: int = 500, record: int = 100, method: str = "smooth",
                   start: str = "fresh", x0: float = 0.0, v0: float = 0.0, rtol: float = 1e-8,
                   atol: float = 1e-10, settle: bool = True,
@@ -116,7 +116,8 @@ def parameter_map(params: ParamsBase, x=("omega", 0.8, 1.0, 100), y=("F0", 0.15,
     Points start from (x0, v0), or from ``u0`` (every component, see ``simulate``).
 
     ``x``, ``y``: (parameter, min, max, n) of the two axes (any parameters of the model, n >= 1
-    values from min to max). ``start``: "fresh" or "continued" (along x). ``lyapunov`` (None:
+    values from min to max); ``x`` defaults to the forcing frequency from 0.8 to 1.0 (a
+    model with a forcing period: that period from 2 pi / 1.0 to 2 pi / 0.8), 100 values. ``start``: "fresh" or "continued" (along x). ``lyapunov`` (None:
     where tangent dynamics exist): also ``lambda1``, ``lambda1_stderr`` and ``motion``.
     ``store``: a directory where finished chunks are written; the same call with the same
     store resumes (``nonsmooth.chunks``). ``engine``: None (all local cores), "local[:N]", a
@@ -142,6 +143,8 @@ def parameter_map(params: ParamsBase, x=("omega", 0.8, 1.0, 100), y=("F0", 0.15,
     from .poincare import settle_tolerance
     from .stability import wants_lyapunov
     params = check_params(params)
+    if x is None:
+        x = (params.model.forcing_param, *params.model.forcing_range(0.8, 1.0), 100)
     xname, xs = check_axis("x", x, params)
     yname, ys = check_axis("y", y, params)
     if xname == yname:

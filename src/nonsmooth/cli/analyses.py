@@ -13,8 +13,25 @@ from .common import (ShowOpt, U0Opt, DEFAULT_MODEL, SectionPhaseOpt, AtolOpt, Da
                      WorkersOpt, check_outputs, chunk_store, echo_written, load_params,
                      preset_label, require_output, resolve_method, save_outputs)
 
-FromOpt = Annotated[float, typer.Option("--from", help="first value of the range")]
-ToOpt = Annotated[float, typer.Option("--to", help="last value of the range")]
+FromOpt = Annotated[Optional[float], typer.Option(
+    "--from", show_default=False,
+    help="first value of the range (default: the command's frequency range, as periods for a "
+         "model with a forcing period)")]
+ToOpt = Annotated[Optional[float], typer.Option("--to", show_default=False,
+                                                help="last value of the range")]
+
+
+def default_range(params, param: str, lo, hi, omega_lo: float, omega_hi: float):
+    """--from/--to, each defaulting to the command's range of forcing frequencies (omega_lo,
+    omega_hi): as periods where ``param`` is the model's forcing period
+    (``Model.forcing_range``)."""
+    if lo is None or hi is None:
+        m = params.model
+        d = (m.forcing_range(omega_lo, omega_hi) if param == m.forcing_param
+             else (omega_lo, omega_hi))
+        lo = d[0] if lo is None else lo
+        hi = d[1] if hi is None else hi
+    return lo, hi
 StepsOpt = Annotated[int, typer.Option("--steps", help="number of values (>= 2)")]
 TransientOpt = Annotated[int, typer.Option("--transient", help="forcing periods discarded first")]
 X0Opt = Annotated[float, typer.Option("--x0", help="initial X")]
@@ -125,8 +142,8 @@ def bifurcation_cmd(
     param: Annotated[Optional[str], typer.Option(
         "--param", show_default=False,
         help="swept parameter, one of the model's; default: its forcing frequency (omega)")] = None,
-    from_: FromOpt = 0.8,
-    to: ToOpt = 1.0,
+    from_: FromOpt = None,
+    to: ToOpt = None,
     steps: StepsOpt = 400,
     sweep: Annotated[str, typer.Option("--sweep", help="up, down, both or fresh")] = "both",
     transient: TransientOpt = 500,
@@ -154,6 +171,7 @@ def bifurcation_cmd(
     from ..simulate import check_forced
     check_forced(params, "bifurcation")
     param = params.model.param(param or params.model.forcing_param).name
+    from_, to = default_range(params, param, from_, to, 0.8, 1.0)
     if sweep not in SWEEPS:
         raise ParameterError(f"sweep: unknown sweep {sweep!r} (known: {', '.join(SWEEPS)})")
     values = value_range(from_, to, steps, f"{param} range", 2 if sweep == "both" else 1,
@@ -182,8 +200,8 @@ def resonance_cmd(
     model: ModelOpt = DEFAULT_MODEL,
     preset: PresetOpt = None,
     set_: SetOpt = None,
-    from_: FromOpt = 0.5,
-    to: ToOpt = 1.6,
+    from_: FromOpt = None,
+    to: ToOpt = None,
     steps: StepsOpt = 400,
     transient: TransientOpt = 500,
     record: Annotated[int, typer.Option("--record", help="periods recorded per value")] = 50,
@@ -215,6 +233,7 @@ def resonance_cmd(
     from ..simulate import check_forced
     check_forced(params, "resonance")
     w = params.model.forcing_param  # the model's forcing frequency (or period)
+    from_, to = default_range(params, w, from_, to, 0.5, 1.6)
     omegas = value_range(from_, to, steps, f"{w} range", 2, max(record, 0))
     for v in (omegas[0], omegas[-1]):
         params.replace(**{w: float(v)})

@@ -7,6 +7,7 @@ from typing import Annotated, Optional
 
 import typer
 
+from .analyses import FromOpt, ToOpt
 from .app import app
 from .common import (DEFAULT_MODEL, SectionPhaseOpt, AtolOpt, DaskOpt, MethodOpt, ModelOpt, OutOpt, PlotOpt, PresetOpt, RtolOpt, SetOpt,
                      U0Opt, WorkersOpt, check_outputs, chunk_store, echo_written, load_params,
@@ -106,8 +107,8 @@ def attractors_cmd(
     preset: PresetOpt = None,
     set_: SetOpt = None,
     param: Annotated[Optional[str], typer.Option("--param", show_default=False, help="the parameter followed, one of the model's; default: its forcing frequency (omega)")] = None,
-    from_: Annotated[float, typer.Option("--from", help="first value of the range")] = 1.0,
-    to: Annotated[float, typer.Option("--to", help="last value of the range")] = 1.25,
+    from_: FromOpt = None,
+    to: ToOpt = None,
     steps: Annotated[int, typer.Option("--steps", help="number of values (>= 2)")] = 26,
     x: Annotated[tuple[float, float], typer.Option("--x", help="range of the initial X: MIN MAX")] = (-3.0, 3.0),
     v: Annotated[tuple[float, float], typer.Option("--v", help="range of the initial V: MIN MAX")] = (-3.0, 3.0),
@@ -126,7 +127,7 @@ def attractors_cmd(
     deaths."""
     from ..analysis.attractor_continuation import attractor_continuation
     from ..sweep import Progress
-    from .analyses import value_range
+    from .analyses import default_range, value_range
 
     params = load_params(preset, set_, model, "fig7", method=method)
     method = resolve_method(params, method)
@@ -134,6 +135,7 @@ def attractors_cmd(
     from ..simulate import check_forced
     check_forced(params, "attractors")
     param = params.model.param(param or params.model.forcing_param).name
+    from_, to = default_range(params, param, from_, to, 1.0, 1.25)
     values = value_range(from_, to, steps, f"{param} range")
     for val in (values[0], values[-1]):
         params.replace(**{param: float(val)})

@@ -65,7 +65,7 @@ def map_cmd(
     from ..simulate import check_forced
     check_forced(params, "map")
     w = params.model.forcing_param
-    x = tuple(x) if x is not None else (w, 0.8, 1.0, 100)
+    x = tuple(x) if x is not None else (w, *params.model.forcing_range(0.8, 1.0), 100)
     if y is None:
         if "F0" not in params.model.param_names:
             from ..errors import ParameterError

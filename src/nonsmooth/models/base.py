@@ -370,6 +370,14 @@ class Model:
         f = np.asarray(P, dtype=np.float64)[..., self.frame_index]
         return 2.0 * math.pi / f if self.period is not None else f
 
+    def forcing_range(self, omega_lo: float, omega_hi: float) -> tuple:
+        """A default range of forcing frequencies (omega_lo < omega_hi) in the units of
+        ``forcing_param``: itself for a frequency, (2 pi / omega_hi, 2 pi / omega_lo) for a
+        period (the same forcings, ascending)."""
+        if self.period is not None:
+            return 2.0 * math.pi / omega_hi, 2.0 * math.pi / omega_lo
+        return omega_lo, omega_hi
+
     @property
     def autonomous(self) -> bool:
         """True for a model that declares no forcing (``omega=None`` and no ``period``)."""

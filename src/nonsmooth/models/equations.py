@@ -84,9 +84,16 @@ class Guard:
     reset: dict | None = None
 
 
+class _Default(str):
+    """A default argument that a call can tell from the same value given explicitly."""
+
+
+_OMEGA = _Default("omega")  # model_from_equations' omega unless a period is given
+
+
 def model_from_equations(name: str, *, states, parameters, modes: dict | None = None,
                          guards: dict | None = None, initial=None, method: str = "exact",
-                         methods: dict | None = None, omega: str | None = "omega",
+                         methods: dict | None = None, omega: str | None = _OMEGA,
                          period: str | None = None, forcing_amplitude: str | None = None, description: str = "",
                          flow_is_homeomorphism: bool = False, closed_form: bool = True,
                          rtol: float | None = None, atol: float | None = None,
@@ -146,13 +153,14 @@ def model_from_equations(name: str, *, states, parameters, modes: dict | None = 
     if len(set(states + pnames)) != len(states) + len(pnames):
         raise bad("state and parameter names must all differ")
     if period is not None:
-        if omega not in (None, "omega"):
+        if omega is not None and omega is not _OMEGA:
             raise bad("a forcing has a frequency (omega) or a period (period), not both")
         omega = None
         if period not in pnames:
             raise bad(f"the forcing period {period!r} must be a parameter")
     elif omega is not None and omega not in pnames:
         raise bad(f"the forcing frequency {omega!r} must be a parameter")
+    omega = None if omega is None else str(omega)  # (a plain str from here on)
     mode_names = tuple(dict.fromkeys(m for spec in methods.values()
                                      for m in (spec.get("modes") or {})))
     if not mode_names:
