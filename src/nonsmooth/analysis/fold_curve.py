@@ -231,7 +231,9 @@ def grazing_curve(params, param: str, param2: str, *, start, special: int | None
     level, ``Model.contact_level``) continued in (``param``, ``param2``): as :func:`fold_curve`
     with the grazing condition max X - level = 0 (max X over the orbit, interior extrema
     located by the kernel; its derivatives by forward differences, taken on whichever side of
-    the contact they fall) in place of the fold's. The same arguments and Dataset (``cusp``
+    the contact they fall) in place of the fold's. This is the first contact of an orbit that
+    has none (as ``continuation`` locates it): an orbit already in contact has other extrema
+    that graze, which this condition does not follow. The same arguments and Dataset (``cusp``
     empty; ``max_X`` per point)."""
     return _special_curve(GRAZING, params, param, param2, start, special, direction, step,
                           max_step, bounds, bounds2, max_points, tol, rtol, atol)
@@ -322,9 +324,11 @@ def _special_curve(kind, params, param, param2, start, special, direction, step,
                   {FOLD: "fold_curve", PERIOD_DOUBLING: "period_doubling_curve",
                    GRAZING: "grazing_curve"}[kind])
     if kind == GRAZING:  # max X on the curve: the contact level there, to the tolerance
-        ds["max_X"] = ("point", np.array([br.level(y[Nz + 1], y[Nz]) + br._map(
-            y[:Nz], y[Nz + 1], y[Nz])[2] for y, _ in pts]), {
-                "long_name": "largest X over the orbit (interior extrema included)"})
+        def max_x(y):
+            got = br._map(y[:Nz], y[Nz + 1], y[Nz])
+            return br.level(y[Nz + 1], y[Nz]) + got[2] if got is not None else math.nan
+        ds["max_X"] = ("point", np.array([max_x(y) for y, _ in pts]), {
+            "long_name": "largest X over the orbit (interior extrema included)"})
     return ds
 
 

@@ -220,6 +220,7 @@ def _unstable_branch(mp: _Map, zs, e, lam, sign, delta, spacing, max_angle, leng
     total = 0.0
     prev = last = math.inf
     count = 0
+    coarse = 0  # chords left longer than spacing: the fundamental domain's resolution
     status = f"iterates: {iterates} iterates of the map"
     end = None
     for j in range(iterates):
@@ -241,10 +242,12 @@ def _unstable_branch(mp: _Map, zs, e, lam, sign, delta, spacing, max_angle, leng
             # reach the window (for a chord of bounded curvature) and is not refined
             out = _outside(Q, mp.window, np.r_[d, 0.0]) & _outside(Q, mp.window, np.r_[0.0, d])
             mark &= ~(out[:-1] & out[1:])
-            mark &= np.diff(S) > 1e-13
+            fine_enough = np.diff(S) > 1e-13
+            coarse += int(np.count_nonzero(mark & ~fine_enough & (d > spacing)))
+            mark &= fine_enough
             if not mark.any() or count + len(S) >= max_points:
                 break
-            new_s = 0.5 * (S[:-1] + S[1:])[mark]
+            new_s = 0.5 * (S[:-1] + S[1:])[mark][:max(1, max_points - count - len(S))]
             new_p = level(j, new_s)
             S = np.r_[S, new_s]
             P = np.r_[P, new_p]
@@ -274,7 +277,9 @@ def _unstable_branch(mp: _Map, zs, e, lam, sign, delta, spacing, max_angle, leng
             end = P[-1]
             status = "converged onto an attractor"
             break
-        if mp.window is not None and not _inside(Q, mp.window).any():
+        if mp.window is not None and np.all(_outside(Q, mp.window, mp.reach)):
+            # beyond the window by more than half its size (nearer, later levels may come
+            # back into it and are followed, unrefined outside it)
             pts[-1], ts[-1] = P, j + S
             status = "left the window"
             break
@@ -284,6 +289,9 @@ def _unstable_branch(mp: _Map, zs, e, lam, sign, delta, spacing, max_angle, leng
             break
     P = np.concatenate([zs[None, :]] + pts) if pts else zs[None, :]
     T = np.concatenate([[-np.inf]] + ts) if ts else np.array([-np.inf])
+    if coarse:
+        status += (f"; {coarse} chords longer than spacing (s resolved to 1e-13: a strongly "
+                   f"expanding saddle; a shorter length or a larger delta)")
     return P, T, status, end
 
 
@@ -449,7 +457,7 @@ def _saddle(params, orbit):
 
 def manifolds(params, orbit, *, x=None, v=None, spacing: float | None = None,
               delta: float | None = None, max_angle: float = 0.3, length: float | None = None,
-              iterates: int = 100, max_points: int = 4000, stable: bool = True,
+              iterates: int | None = None, max_points: int = 4000, stable: bool = True,
               radius: float | None = None, max_search: int = 100,
               tol: float | None = None) -> xr.Dataset:
     """The stable and unstable manifolds of the saddle ``orbit`` (a converged
@@ -463,7 +471,8 @@ def manifolds(params, orbit, *, x=None, v=None, spacing: float | None = None,
     of the first point from the saddle (default spacing / 1000); ``max_angle``: the largest
     turn (radians) at a point before it is refined; ``length``: the largest arc length of a
     branch (default 4 window diagonals, else 100 spacings); ``iterates``: the most
-    iterates of a fundamental domain (unstable); ``max_points`` per branch; ``stable``: also
+    iterates of a fundamental domain (unstable; default 100 more than it takes the multiplier
+    to carry delta to ``length``); ``max_points`` per branch; ``stable``: also
     the stable manifold (needs a two-dimensional section); ``radius``: the saddle's
     neighbourhood in the classification (default 5 spacings); ``max_search``: iterates of the
     map before a point is called unclassified; ``tol``: the stable points' accuracy across
@@ -471,11 +480,13 @@ def manifolds(params, orbit, *, x=None, v=None, spacing: float | None = None,
 
     Returns a Dataset over ``point`` (all branches one after the other): ``X``, ``V`` (and the
     further state components), ``branch`` (flag: unstable_plus, unstable_minus, stable_plus,
-    stable_minus) and ``level`` (j + s of the unstable points; NaN on the stable ones); over
-    ``branch_index``: ``branch_status``-style attrs, ``end_X``/``end_V`` (where an unstable
-    branch converged, else NaN); the saddle (``saddle_X``, ``saddle_V``, the multipliers and
+    stable_minus) and ``level`` (j + s of the unstable points; NaN on the stable ones); attrs
+    ``status_<branch>`` (how each ended); over ``branch_index``: ``end_X``/``end_V`` (where an
+    unstable branch converged, else NaN); the saddle (``saddle_X``, ``saddle_V``, the multipliers and
     eigenvectors); over ``crossing``: the homoclinic points (``crossing_X``, ``crossing_V``,
-    ``crossing_angle``, ``crossing_unstable``, ``crossing_stable``)."""
+    ``crossing_angle``, ``crossing_unstable``, ``crossing_stable``; inside the window, where
+    one is given). Points lie within ``spacing`` of each other inside the window; outside it
+    the unstable branches are followed but not refined."""
     params = check_params(params)
     m = params.model
     if m.autonomous:
@@ -491,7 +502,7 @@ def manifolds(params, orbit, *, x=None, v=None, spacing: float | None = None,
     max_angle = _positive("max_angle", max_angle)
     length = (_positive("length", length) if length is not None
               else 4.0 * diag if diag else 100.0 * spacing)
-    iterates = check_int("iterates", iterates, 1)
+    iterates = check_int("iterates", iterates, 1) if iterates is not None else None
     max_points = check_int("max_points", max_points, 3)
     max_search = check_int("max_search", max_search, 1)
     radius = _positive("radius", radius) if radius is not None else 5.0 * spacing
@@ -503,6 +514,13 @@ def manifolds(params, orbit, *, x=None, v=None, spacing: float | None = None,
     N = setup.N
     e_u = np.zeros(N)
     e_u[act] = E[:, iu].real / np.linalg.norm(E[:, iu].real)
+    if stable and (int(act.sum()) != 2 or m.n != 2):
+        raise ParameterError(f"stable: the stable manifold is a curve only for a "
+                             f"two-dimensional section; this one has {int(act.sum())} "
+                             f"components (give stable=False)")
+    if iterates is None:  # enough levels to carry the fundamental domain across the window
+        iterates = 100 + int(math.ceil(math.log(max(length, 10 * spacing) / delta)
+                                       / math.log(abs(lam))))
     mp = _Map(setup, solver, p, q, window)
     mp.zfill = zs
     mp.lam = abs(lam)
@@ -518,10 +536,6 @@ def manifolds(params, orbit, *, x=None, v=None, spacing: float | None = None,
     e_s = np.full(N, np.nan)
     stable_method = ""
     if stable:
-        if int(act.sum()) != 2 or nshow != 2:
-            raise ParameterError(f"stable: the stable manifold is a curve only for a "
-                                 f"two-dimensional section; this one has {int(act.sum())} "
-                                 f"components (give stable=False)")
         i_s = 1 - iu
         if abs(mu[i_s].imag) > 0.0:
             raise ParameterError("orbit: complex stable multipliers")
@@ -539,11 +553,12 @@ def manifolds(params, orbit, *, x=None, v=None, spacing: float | None = None,
             statuses.append(status)
             ends.append(np.full(nshow, np.nan))
     cross = []
-    if stable:
+    if stable:  # (inside the window: outside it the branches are not refined)
         for a in (0, 1):
             for b in (2, 3):
                 for pt, ang, i, j in _crossings(branches[a][:, :2], branches[b][:, :2]):
-                    cross.append((pt, ang, a, b))
+                    if window is None or _inside(pt[None, :], window)[0]:
+                        cross.append((pt, ang, a, b))
     return _dataset(params, solver, k, q, zs[:nshow], mu, e_u[act], e_s, branches, levels,
                     statuses, ends, cross, stable_method, dict(
                         spacing=spacing, delta=delta, max_angle=max_angle, length=length,
@@ -563,8 +578,8 @@ def _dataset(params, solver, k, q, zs, mu, e_u, e_s, branches, levels, statuses,
     cp = np.array([c[0] for c in cross]).reshape(-1, 2)
     ds = xr.Dataset(
         {
-            "X": ("point", U[:, 0], {"long_name": "X on the manifold (section t = kT)"}),
-            "V": ("point", U[:, 1], {"long_name": "V on the manifold (section t = kT)"}),
+            "X": ("point", U[:, 0], {"long_name": "X on the manifold (at the section)"}),
+            "V": ("point", U[:, 1], {"long_name": "V on the manifold (at the section)"}),
             "branch": ("point", flag, {"long_name": "branch of the manifold",
                                        "flag_values": np.arange(nb_, dtype=np.int8),
                                        "flag_meanings": " ".join(names)}),
@@ -590,9 +605,11 @@ def _dataset(params, solver, k, q, zs, mu, e_u, e_s, branches, levels, statuses,
             "crossing_angle": ("crossing", np.array([c[1] for c in cross], float), {
                 "long_name": "angle between the branches at the crossing", "units": "rad"}),
             "crossing_unstable": ("crossing", np.array([c[2] for c in cross], np.int8), {
-                "long_name": "the unstable branch (a value of branch)"}),
+                "long_name": "the unstable branch", "flag_values": np.arange(nb_, dtype=np.int8),
+                "flag_meanings": " ".join(names)}),
             "crossing_stable": ("crossing", np.array([c[3] for c in cross], np.int8), {
-                "long_name": "the stable branch (a value of branch)"}),
+                "long_name": "the stable branch", "flag_values": np.arange(nb_, dtype=np.int8),
+                "flag_meanings": " ".join(names)}),
         },
         coords={"point": np.arange(len(U)), "branch_index": ("branch_index", np.arange(nb_), {
             "long_name": "branch", "flag_values": np.arange(nb_, dtype=np.int8),
@@ -635,6 +652,12 @@ def homoclinic_tangency(params, orbit, param: str, bounds, *, tol: float = 1e-4,
     if not (math.isfinite(a) and math.isfinite(b) and a != b):
         raise ParameterError(f"bounds: expected two different finite values, got {bounds!r}")
     tol = _positive("tol", tol)
+    import inspect
+    known = set(inspect.signature(manifolds).parameters) - {"params", "orbit", "stable"}
+    for key in manifold_kw:
+        if key not in known:
+            raise ParameterError(f"{key}: not an option of manifolds here (known: "
+                                 f"{', '.join(sorted(known))})")
     _saddle(params, orbit)  # checks the orbit
     done = {float(getattr(params, name)): orbit}
     kw = dict(k=int(orbit.attrs.get("k", 1)), method=str(orbit.attrs.get("method", "exact")),
@@ -665,6 +688,12 @@ def homoclinic_tangency(params, orbit, param: str, bounds, *, tol: float = 1e-4,
         pv, got = saddle(value)
         ds = manifolds(pv, got, **manifold_kw)
         evals.append((value, int(ds.sizes["crossing"])))
+        short = [b for b in BRANCH_NAMES[:2] if ds.attrs[f"status_{b}"].startswith(
+            ("iterates", "max_points", "integration failed"))]
+        if not ds.sizes["crossing"] and short:  # no crossing found, but not a full search
+            raise ParameterError(f"{name}: at {name} = {value:g} the unstable branch {short[0]} "
+                                 f"stopped early ({ds.attrs[f'status_{short[0]}']}); give "
+                                 f"more iterates or max_points")
         return ds
 
     lo_ds = crossings(a)

@@ -135,6 +135,11 @@ def continue_cmd(
                              f"{param} = {lam0:g} (set it with --set {param}=VALUE)")
     cycles = section is not None or params.model.autonomous
     sec = (section or "V", crossing) if cycles else None
+    if extended is not None and values is not None:
+        raise ParameterError("values: --extended follows the curve itself; give --bounds2, "
+                             "not --values")
+    if extended is None and bounds2 is not None:
+        raise ParameterError("bounds2: only with --extended")
     if extended is not None:
         return _extended(params, preset, param, two_param, special, extended, bounds2, k, x0,
                          v0, u0, transient, direction, step, max_step, bounds, max_points,

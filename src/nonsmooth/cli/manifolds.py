@@ -49,7 +49,7 @@ def manifolds_cmd(
     """The stable and unstable manifolds of the saddle found from (x0, v0) by Newton shooting
     (default: Fig. 7's saddle): both branches of each, grown in the window (--x, --v), their
     homoclinic points, and a figure over the basins (--basins-grid). Exit status 1 when no
-    saddle was found from the start."""
+    orbit was found from the start, 2 when the orbit found is not a saddle."""
     from ..analysis.manifolds import BRANCH_NAMES, manifolds
     from ..analysis.stability import periodic_orbit
     from ..simulate import check_int
@@ -77,10 +77,10 @@ def manifolds_cmd(
                      lyapunov=False)
     from ..plot.manifolds import plot_manifolds
     save_outputs(ds, preset, out, plot, lambda d: plot_manifolds(d, basins=bas))
-    mu = ds.multiplier_real.values
+    mu = ds.multiplier_real.values + 1j * ds.multiplier_imag.values
     typer.echo(f"{preset} ({method}): saddle of period {k} at (X, V) = "
                f"({float(ds.saddle_X):+.6g}, {float(ds.saddle_V):+.6g}), multipliers "
-               + ", ".join(f"{m:.6g}" for m in mu))
+               + ", ".join(f"{m.real:.6g}" if m.imag == 0 else f"{m:.6g}" for m in mu))
     flag = ds.branch.values
     rows = []
     for b in range(ds.sizes["branch_index"]):
