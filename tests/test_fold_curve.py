@@ -45,6 +45,28 @@ def test_the_fold_curve_of_the_cusp_normal_form_runs_through_the_cusp(setup):
     assert fc.sizes["cusp"] == 1
     assert abs(float(fc.cusp_a[0])) < 1e-4 and abs(float(fc.cusp_b[0])) < 2e-3
     assert fc.attrs["analysis"] == "fold_curve" and "param_a" not in fc.attrs
+    assert fc.sizes["codim2"] == 0  # the other multiplier, e^(-T), never crosses the circle
+
+
+def test_a_codimension_two_point_on_a_fold_curve_is_located_and_labelled():
+    """With a third component W' = (X - c) W (W = 0 on the orbit, its multiplier
+    e^((X - c) T)), the fold curve meets a second multiplier 1 where the fold's X is c: a 1:1
+    resonance at (a, b) = (-2 c^3, 3 c^2), here c = 0.3: (-0.054, 0.27)."""
+    m = ns.model_from_equations(
+        "cusp_with_w", states=("X", "V", "W"),
+        parameters={"a": 0.3, "b": 1.0, "c": 0.3, "omega": 1.0},
+        modes={"free": ["a + b*X - X**3", "-V + cos(omega*t)", "(X - c)*W"]}, method="smooth",
+        forcing_amplitude=None)
+    p = m.params()
+    br = ns.continuation(p, "a", x0=-0.8, bounds=(0.3, 0.5), method="smooth", step=0.02)
+    fc = ns.fold_curve(p, "a", "b", start=br, direction="down", step=0.02,
+                       bounds=(-1.0, 1.0), bounds2=(-0.5, 1.5))
+    assert fc.X_section.values[-1] > 0.5  # through the cusp and past X = c
+    assert fc.sizes["codim2"] == 1
+    assert fc.codim2_type.attrs["flag_meanings"].split()[int(fc.codim2_type[0])] == \
+        "one_to_one_resonance"
+    assert abs(float(fc.codim2_a[0]) + 0.054) < 1e-4  # measured 1.1e-5 (steps 0.02)
+    assert abs(float(fc.codim2_b[0]) - 0.27) < 1e-3  # measured 2.5e-4
 
 
 def test_fold_curve_bad_input(setup):

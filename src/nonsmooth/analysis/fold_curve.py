@@ -171,6 +171,45 @@ class _GrazingBranch(_FoldBranch):
         return self.setup.z_of(s1) - z, M, g, s0
 
 
+#: codimension-two points on a curve: (kind of curve, test crossing zero) -> name. The tests,
+#: over the multipliers R other than the curve's critical one: prod(R - 1) (another multiplier
+#: 1), prod(R + 1) (another -1), prod over complex pairs of (mu_i mu_j - 1) (a pair on the unit
+#: circle).
+CODIM2_NAMES = ("one_to_one_resonance", "fold_flip", "fold_neimark_sacker",
+                "one_to_two_resonance", "flip_neimark_sacker", "grazing_fold", "grazing_flip",
+                "grazing_neimark_sacker")
+_CODIM2 = {(FOLD, 0): 0, (FOLD, 1): 1, (FOLD, 2): 2,
+           (PERIOD_DOUBLING, 0): 1, (PERIOD_DOUBLING, 1): 3, (PERIOD_DOUBLING, 2): 4,
+           (GRAZING, 0): 5, (GRAZING, 1): 6, (GRAZING, 2): 7}
+
+
+def _codim2_tests(mu, kind):
+    """The three test functions of a point's multipliers (see CODIM2_NAMES)."""
+    mu = np.asarray(mu)
+    if kind in (FOLD, PERIOD_DOUBLING) and len(mu):
+        crit = 1.0 if kind == FOLD else -1.0
+        mu = np.delete(mu, int(np.argmin(np.abs(mu - crit))))
+    real = mu[np.abs(mu.imag) <= 1e-12 * np.maximum(1.0, np.abs(mu))].real
+    pairs = mu[mu.imag > 1e-12 * np.maximum(1.0, np.abs(mu))]
+    return (float(np.prod(real - 1.0)), float(np.prod(real + 1.0)),
+            float(np.prod(np.abs(pairs) ** 2 - 1.0)) if len(pairs) else math.nan)
+
+
+def _codim2(pts, kind, N):
+    """(type, l1, l2, index) of each codimension-two point: a test of CODIM2_NAMES changes
+    sign between points i and i + 1; located by linear interpolation of the test."""
+    out = []
+    tests = [_codim2_tests(f["mu"], kind) for _, f in pts]
+    for i in range(len(pts) - 1):
+        for j in range(3):
+            a, b = tests[i][j], tests[i + 1][j]
+            if math.isfinite(a) and math.isfinite(b) and a * b < 0.0:
+                s = a / (a - b)
+                y = pts[i][0] + s * (pts[i + 1][0] - pts[i][0])
+                out.append((_CODIM2[(kind, j)], float(y[N]), float(y[N - 1]), i))
+    return out
+
+
 def _cusps(pts, N):
     """(l1, l2, index) of each cusp: the curve's velocity in (l1, l2) (the parameter part of
     its unit tangent) turns by more than a right angle between points i and i + 1 (at a cusp
@@ -201,6 +240,12 @@ def fold_curve(params, param: str, param2: str, *, start, special: int | None = 
     "down", with arclength steps from ``step`` (adapted up to ``max_step``, default 10 x) until
     ``param`` leaves ``bounds`` or ``param2`` leaves ``bounds2`` (default: unbounded),
     ``max_points`` or the corrector fails. The branch's section phase is kept.
+
+    Codimension-two points are located where another multiplier crosses 1 (a 1:1 resonance),
+    -1 (fold-flip) or a complex pair the unit circle (fold-Neimark-Sacker): over ``codim2``,
+    ``codim2_type`` (flags), ``codim2_<param>``, ``codim2_<param2>``, ``codim2_after_point``;
+    the period-doubling and grazing curves likewise (fold-flip, 1:2 resonance,
+    flip-Neimark-Sacker; grazing-fold, grazing-flip, grazing-Neimark-Sacker).
 
     Returns a Dataset over ``point``: ``<param>``, ``<param2>``, the section point
     (``X_section``, ``V_section``, ...), the multipliers (``multiplier_real/imag/abs``, one of
@@ -323,6 +368,19 @@ def _special_curve(kind, params, param, param2, start, special, direction, step,
     ds = _dataset(params, solver, p1, p2, k, pts, cusps, status, Nz,
                   {FOLD: "fold_curve", PERIOD_DOUBLING: "period_doubling_curve",
                    GRAZING: "grazing_curve"}[kind])
+    c2 = _codim2(pts, kind, Nz + 1)
+    s1, s2 = m.param(p1), m.param(p2)
+    ds["codim2_type"] = ("codim2", np.array([c[0] for c in c2], np.int8), {
+        "long_name": "codimension-two point on the curve",
+        "flag_values": np.arange(len(CODIM2_NAMES), dtype=np.int8),
+        "flag_meanings": " ".join(CODIM2_NAMES)})
+    ds["codim2_" + p1] = ("codim2", np.array([c[1] for c in c2], float), {
+        "long_name": f"{p1} at the codimension-two point", "units": s1.units})
+    ds["codim2_" + p2] = ("codim2", np.array([c[2] for c in c2], float), {
+        "long_name": f"{p2} at the codimension-two point", "units": s2.units})
+    ds["codim2_after_point"] = ("codim2", np.array([c[3] for c in c2], np.int64), {
+        "long_name": "the point lies between this point and the next"})
+    ds.attrs["n_codim2"] = len(c2)
     if kind == GRAZING:  # max X on the curve: the contact level there, to the tolerance
         def max_x(y):
             got = br._map(y[:Nz], y[Nz + 1], y[Nz])

@@ -254,4 +254,9 @@ def _extended(params, preset, param, param2, special, way, bounds2, k, x0, v0, u
     for i in range(ds.sizes["cusp"]):
         typer.echo(f"cusp at {param} = {float(ds['cusp_' + param][i]):.8g}, {p2} = "
                    f"{float(ds['cusp_' + p2][i]):.8g}")
+    names = ds["codim2_type"].attrs["flag_meanings"].split()
+    for i in range(ds.sizes["codim2"]):
+        typer.echo(f"{names[int(ds.codim2_type[i])].replace('_', ' ')} at {param} = "
+                   f"{float(ds['codim2_' + param][i]):.8g}, {p2} = "
+                   f"{float(ds['codim2_' + p2][i]):.8g}")
     echo_written(out, plot)

@@ -246,7 +246,7 @@ def plot_two_parameter(ds, ax=None):
 def plot_special_curve(ds, ax=None):
     """A fold, period-doubling or grazing curve continued as an extended system
     (``fold_curve``, ``period_doubling_curve``, ``grazing_curve``): the first parameter versus the second, its
-    start (o) and its cusps (x)."""
+    start (o), its cusps (x) and its other codimension-two points (diamonds)."""
     param, param2 = ds.attrs["param"], ds.attrs["param2"]
     if ax is None:
         fig, ax = new_figure(figsize=(7, 5))
@@ -261,6 +261,11 @@ def plot_special_curve(ds, ax=None):
     if ds.sizes.get("cusp", 0):
         ax.plot(ds["cusp_" + param].values, ds["cusp_" + param2].values, "x", color="tab:red",
                 ms=10, mew=2, label="cusp")
+    if ds.sizes.get("codim2", 0):
+        names = ds["codim2_type"].attrs["flag_meanings"].split()
+        for i in range(ds.sizes["codim2"]):
+            ax.plot(float(ds["codim2_" + param][i]), float(ds["codim2_" + param2][i]), "D",
+                    mfc="none", ms=8, label=names[int(ds["codim2_type"][i])].replace("_", " "))
     ax.set_xlabel(f"{param_symbol(m, param)} [{ds[param].attrs.get('units', '')}]")
     ax.set_ylabel(f"{param_symbol(m, param2)} [{ds[param2].attrs.get('units', '')}]")
     ax.set_title(f"{what} continued in ({param}, {param2}): {ds.attrs.get('status', '')}",
