@@ -145,7 +145,7 @@ def test_cli_continues_the_fig6a_fold_as_an_extended_system(tmp_path, capsys):
     assert np.max(np.abs(ds.multiplier_real.values[:, 0] - 1.0)) < 1e-7
     assert png.read_bytes()[:4] == b"\x89PNG"
     for extra, needle in ((["--extended", "sideways"], "extended"),
-                          (["--extended", "up", "--special", "neimark_sacker"], "special")):
+                          (["--extended", "up", "--special", "nope"], "special")):
         code, out, err = run_cli(args + extra + ["-o", str(nc)], capsys)
         assert code == 2
         one_line(err, needle)

@@ -116,11 +116,33 @@ def test_a_manifold_point_mapped_by_the_kernel_lands_on_its_branch(fig7, method)
             assert _distance_to(img, W) <= (1e-7 if b < 2 else spacing ** 2 / 2), (b, i)
 
 
-def test_the_first_homoclinic_tangency_of_the_double_well_is_melnikovs():
-    m = ns.model_from_equations(
+def double_well():
+    return ns.model_from_equations(
         "double_well", states=("X", "V"), parameters={"delta": 0.05, "F0": 0.03, "omega": 1.0},
         modes={"free": ["V", "-delta*V + X - X**3 + F0*cos(omega*t)"]}, method="smooth")
-    p = m.params()
+
+
+def test_the_neimark_sacker_curve_of_an_orbit_in_a_well_is_zero_damping():
+    """(issue 21, item 4) The flow's divergence is -delta, so det M = e^(-delta T)
+    (Liouville) and the orbit in a well has its complex pair on the unit circle exactly where
+    delta = 0, whatever omega: the Neimark-Sacker curve in (delta, omega), continued both ways
+    between the strong resonances, is delta = 0."""
+    p = double_well().params(omega=1.1)
+    br = ns.continuation(p, "delta", x0=1.0, bounds=(-0.05, 0.05), direction="down",
+                         method="smooth", step=0.02)
+    assert br.special_type.values.tolist() == [3]
+    for way in ("up", "down"):
+        c = ns.neimark_sacker_curve(p, "delta", "omega", start=br, direction=way, step=0.02,
+                                    bounds2=(1.02, 1.3))
+        assert c.attrs["status"] == "left the bounds of omega"
+        assert c.attrs["analysis"] == "neimark_sacker_curve" and c.sizes["point"] > 3
+        assert np.max(np.abs(c.delta.values)) < 1e-9
+        assert np.max(np.abs(c.multiplier_abs.values - 1.0)) < 1e-9
+        assert np.all(np.abs(c.multiplier_imag.values) > 1e-3)  # a complex pair
+
+
+def test_the_first_homoclinic_tangency_of_the_double_well_is_melnikovs():
+    p = double_well().params()
     orbit = ns.periodic_orbit(p, x0=-0.015, v0=0.0, method="smooth")
     assert orbit.attrs["converged"] == 1 and float(orbit.multiplier_abs[0]) > 400
     t = ns.homoclinic_tangency(p, orbit, "F0", (0.03, 0.045), tol=2e-4, x=(-2, 2),

@@ -41,6 +41,7 @@ _LAZY = {
     "fold_curve": ".analysis.fold_curve",
     "period_doubling_curve": ".analysis.fold_curve",
     "grazing_curve": ".analysis.fold_curve",
+    "neimark_sacker_curve": ".analysis.fold_curve",
     "manifolds": ".analysis.manifolds",
     "homoclinic_tangency": ".analysis.manifolds",
     "parameter_map": ".analysis.parameter_map",
@@ -59,7 +60,7 @@ _SUBMODULES = ("analysis", "cli", "errors", "integrate", "io", "kernels", "model
                "plot", "reproduction", "status", "sweep", "chunks")
 
 __all__ = ["__version__", "Params", "PARAM_NAMES", "model", "models", "model_from_equations", "Guard", "preset", "PRESETS", "simulate", "reproduce", "Solver",
-           "eta_study", "lyapunov", "periodic_orbit", "continuation", "two_parameter_curve", "fold_curve", "period_doubling_curve", "grazing_curve", "manifolds", "homoclinic_tangency", "parameter_map", "poincare", "bifurcation_diagram", "resonance_curve", "basins", "basin_entropy", "attractor_continuation",
+           "eta_study", "lyapunov", "periodic_orbit", "continuation", "two_parameter_curve", "fold_curve", "period_doubling_curve", "grazing_curve", "neimark_sacker_curve", "manifolds", "homoclinic_tangency", "parameter_map", "poincare", "bifurcation_diagram", "resonance_curve", "basins", "basin_entropy", "attractor_continuation",
            "surface_section", "surface_bifurcation_diagram", "limit_cycle", "equilibria", "equilibrium_branch",
            "limit_cycle_branch", "surface_basins",
            "NonsmoothError", "ParameterError", "OutputError", "IntegrationError"]

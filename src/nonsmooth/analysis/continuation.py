@@ -307,10 +307,11 @@ def continuation(params, param: str, *, start=None, k: int = 1, x0: float = 0.0,
     return ds
 
 
-def _follow(br, pts, t, step, max_step, max_points, lo, hi, relocate=None):
+def _follow(br, pts, t, step, max_step, max_points, lo, hi, relocate=None, bounds2=None):
     """Pseudo-arclength steps from the last of ``pts`` ((y, features) pairs; y = the branch's
     coordinates, then the parameter) along the unit tangent ``t``, appending each corrected
-    point, until ``max_points``, the parameter leaves (lo, hi), or the corrector fails even at
+    point, until ``max_points``, the parameter leaves (lo, hi) (or coordinate i leaves
+    (lo2, hi2), ``bounds2`` = (i, lo2, hi2): status "left bounds2"), or the corrector fails even at
     step x MIN_STEP and ``relocate(br, y, t)`` (if given) offers no way on (else it returns
     (branch, y, t, corrected point, step, section phase)). The step adapts to the corrector's
     iterations; sign changes of the test functions between points are located
@@ -351,6 +352,9 @@ def _follow(br, pts, t, step, max_step, max_points, lo, hi, relocate=None):
         t = t1
         if not lo <= y1[N] <= hi:
             status = "left the bounds"
+            break
+        if bounds2 is not None and not bounds2[1] <= y1[bounds2[0]] <= bounds2[2]:
+            status = "left bounds2"
             break
         ds = min(max_step, ds * 1.5) if iters <= 3 else (ds * 0.5 if iters > 6 else ds)
     return br, specials, moves, status

@@ -53,7 +53,7 @@ class _FoldBranch:
     def __init__(self, setup: TangentSetup, p0, i1: int, i2: int, k: int, tol: float,
                  mu: float = 1.0):
         self.setup, self.p0, self.i1, self.i2, self.k, self.tol = setup, p0, i1, i2, k, tol
-        self.mu = mu  # the critical multiplier: 1 (fold), -1 (period doubling)
+        self.mu = mu  # the critical multiplier: 1 (fold), -1 (period doubling), None (NS)
         self.N = setup.N + 1
         self.template = None
 
@@ -72,7 +72,15 @@ class _FoldBranch:
             return None
         act = _active(M, self.setup.n)
         Ma = M[np.ix_(act, act)]
-        g = float(np.linalg.det(Ma - self.mu * np.eye(len(Ma))))
+        if self.mu is None:  # Neimark-Sacker: a pair of multipliers with product 1
+            ev = np.linalg.eigvals(Ma)
+            g = 1.0
+            for i in range(len(ev)):
+                for j in range(i + 1, len(ev)):
+                    g *= ev[i] * ev[j] - 1.0
+            g = float(np.real(g))
+        else:
+            g = float(np.linalg.det(Ma - self.mu * np.eye(len(Ma))))
         return self.setup.z_of(s1) - z, M, g, s0
 
     def _ends(self, z, l1, l2, s0):
@@ -268,6 +276,20 @@ def period_doubling_curve(params, param: str, param2: str, *, start,
                           step, max_step, bounds, bounds2, max_points, tol, rtol, atol)
 
 
+def neimark_sacker_curve(params, param: str, param2: str, *, start,
+                         special: int | None = None, direction: str = "up", step: float = 0.01,
+                         max_step: float | None = None, bounds=None, bounds2=None,
+                         max_points: int = 300, tol: float = 1e-9, rtol: float = 1e-10,
+                         atol: float = 1e-12) -> xr.Dataset:
+    """A Neimark-Sacker (torus) bifurcation of ``start``'s branch continued in (``param``,
+    ``param2``): as :func:`fold_curve` with the condition prod_{i<j} (mu_i mu_j - 1) = 0 (a
+    pair of multipliers with product 1: a complex pair on the unit circle; its derivatives by
+    differences of the eigenvalues, which are smooth away from a double multiplier) in place
+    of the fold's. A real pair with product 1 (a neutral saddle) satisfies it too."""
+    return _special_curve(NEIMARK_SACKER, params, param, param2, start, special, direction,
+                          step, max_step, bounds, bounds2, max_points, tol, rtol, atol)
+
+
 def grazing_curve(params, param: str, param2: str, *, start, special: int | None = None,
                   direction: str = "up", step: float = 0.01, max_step: float | None = None,
                   bounds=None, bounds2=None, max_points: int = 300, tol: float = 1e-9,
@@ -288,7 +310,8 @@ def _special_curve(kind, params, param, param2, start, special, direction, step,
                    bounds, bounds2, max_points, tol, rtol, atol):
     from ..kernels import Solver
     from ..simulate import check_params
-    what = {FOLD: "fold", PERIOD_DOUBLING: "period doubling", GRAZING: "grazing"}[kind]
+    what = {FOLD: "fold", PERIOD_DOUBLING: "period doubling", GRAZING: "grazing",
+            NEIMARK_SACKER: "Neimark-Sacker point"}[kind]
     params = check_params(params)
     m = params.model
     p1, p2 = m.param(param).name, m.param(param2).name
@@ -336,7 +359,7 @@ def _special_curve(kind, params, param, param2, start, special, direction, step,
         br = _GrazingBranch(setup, p0, m.index[p1], m.index[p2], k, tol, level)
     else:
         br = _FoldBranch(setup, p0, m.index[p1], m.index[p2], k, tol,
-                         mu=1.0 if kind == FOLD else -1.0)
+                         mu={FOLD: 1.0, PERIOD_DOUBLING: -1.0}.get(kind))
     Nz = setup.N
     z0 = np.zeros(Nz)
     zc = np.asarray(components(start, "special_", "_section").values[special], dtype=float)
@@ -357,18 +380,15 @@ def _special_curve(kind, params, param, param2, start, special, direction, step,
     if t[Nz] * sign < 0:
         t = -t
     pts = [(y, br.features(y, ev, t))]
-    # (_follow bounds the last coordinate, param; param2's bounds are applied after)
-    _, _, _, status = _follow(br, pts, t, step, max_step, max_points, lo, hi)
-    ys = np.array([y for y, _ in pts])
-    out2 = np.flatnonzero((ys[:, Nz] < lo2) | (ys[:, Nz] > hi2))
-    if out2.size:
-        pts = pts[:out2[0] + 1]
+    _, _, _, status = _follow(br, pts, t, step, max_step, max_points, lo, hi,
+                              bounds2=(Nz, lo2, hi2))
+    if status == "left bounds2":
         status = f"left the bounds of {p2}"
     cusps = _cusps(pts, Nz + 1) if kind == FOLD else []
     ds = _dataset(params, solver, p1, p2, k, pts, cusps, status, Nz,
                   {FOLD: "fold_curve", PERIOD_DOUBLING: "period_doubling_curve",
-                   GRAZING: "grazing_curve"}[kind])
-    c2 = _codim2(pts, kind, Nz + 1)
+                   GRAZING: "grazing_curve", NEIMARK_SACKER: "neimark_sacker_curve"}[kind])
+    c2 = _codim2(pts, kind, Nz + 1) if kind != NEIMARK_SACKER else []
     s1, s2 = m.param(p1), m.param(p2)
     ds["codim2_type"] = ("codim2", np.array([c[0] for c in c2], np.int8), {
         "long_name": "codimension-two point on the curve",

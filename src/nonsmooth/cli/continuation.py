@@ -93,8 +93,8 @@ def continue_cmd(
                            "or both")] = "decreasing",
     extended: Annotated[Optional[str], typer.Option(
         "--extended", show_default=False,
-        help="with --two-param and --special fold, period_doubling or grazing: continue the "
-             "branch's first such point as one extended system in (--param, --two-param), through "
+        help="with --two-param and --special (fold, period_doubling, neimark_sacker or "
+             "grazing): continue the branch's first such point as one extended system in (--param, --two-param), through "
              "turning points and cusps, with --two-param going up or down at first (no "
              "--values)")] = None,
     bounds2: Annotated[Optional[tuple[float, float]], typer.Option(
@@ -221,7 +221,8 @@ def _extended(params, preset, param, param2, special, way, bounds2, k, x0, v0, u
     period doubling, or grazing) continued as an extended system (``fold_curve``,
     ``period_doubling_curve``, ``grazing_curve``)."""
     from ..analysis.continuation import continuation
-    from ..analysis.fold_curve import fold_curve, grazing_curve, period_doubling_curve
+    from ..analysis.fold_curve import (fold_curve, grazing_curve, neimark_sacker_curve,
+                                       period_doubling_curve)
     from ..plot.continuation import plot_special_curve
 
     if param2 is None:
@@ -229,10 +230,10 @@ def _extended(params, preset, param, param2, special, way, bounds2, k, x0, v0, u
     if way not in ("up", "down"):
         raise ParameterError(f"extended: expected 'up' or 'down', got {way!r}")
     curves = {"fold": fold_curve, "period_doubling": period_doubling_curve,
-              "grazing": grazing_curve}
+              "grazing": grazing_curve, "neimark_sacker": neimark_sacker_curve}
     if special not in curves:
-        raise ParameterError(f"special: --extended follows fold, period_doubling or grazing, "
-                             f"got {special!r}")
+        raise ParameterError(f"special: --extended follows fold, period_doubling, "
+                             f"neimark_sacker or grazing, got {special!r}")
     if sec is not None:
         raise ParameterError("extended: limit cycles on a section are not supported here")
     p2 = params.model.param(param2).name

@@ -254,7 +254,7 @@ def plot_special_curve(ds, ax=None):
         fig = ax.figure
     m = model_of(ds)
     what = {"fold_curve": "fold", "period_doubling_curve": "period doubling",
-            "grazing_curve": "grazing"}.get(ds.attrs.get("analysis"), "special point")
+            "grazing_curve": "grazing", "neimark_sacker_curve": "Neimark-Sacker"}.get(ds.attrs.get("analysis"), "special point")
     ax.plot(ds[param].values, ds[param2].values, "-", color="k", lw=1.3, label=f"{what} curve")
     ax.plot(ds[param].values[0], ds[param2].values[0], "o", mfc="none", mec="k",
             label="start (on the branch)")
