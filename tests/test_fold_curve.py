@@ -14,13 +14,19 @@ from nonsmooth.errors import ParameterError
 pytestmark = pytest.mark.filterwarnings("ignore::numba.NumbaExperimentalFeatureWarning")
 
 
+def cusp_model():
+    """The cusp normal form with a forced V and a third component W' = (X - c) W (W = 0 on
+    the orbits, its multiplier e^((X - c) T): far from 1 for c = 5)."""
+    return ns.model_from_equations(
+        "cusp_with_w", states=("X", "V", "W"),
+        parameters={"a": 0.3, "b": 1.0, "c": 5.0, "omega": 1.0},
+        modes={"free": ["a + b*X - X**3", "-V + cos(omega*t)", "(X - c)*W"]}, method="smooth",
+        forcing_amplitude=None)
+
+
 @pytest.fixture(scope="module")
 def setup():
-    m = ns.model_from_equations(
-        "cusp_normal_form", states=("X", "V"), parameters={"a": 0.3, "b": 1.0, "omega": 1.0},
-        modes={"free": ["a + b*X - X**3", "-V + cos(omega*t)"]}, method="smooth",
-        forcing_amplitude=None)
-    p = m.params(a=0.3, b=1.0)
+    p = cusp_model().params(a=0.3, b=1.0)
     br = ns.continuation(p, "a", x0=-0.8, bounds=(0.3, 0.5), method="smooth", step=0.02)
     return p, br
 
@@ -35,29 +41,25 @@ def test_the_fold_curve_of_the_cusp_normal_form_runs_through_the_cusp(setup):
     np.testing.assert_allclose(a, -2 * X ** 3, atol=1e-9)
     np.testing.assert_allclose(b, 3 * X ** 2, atol=1e-9)
     np.testing.assert_allclose(fc.V_section.values, 0.5, atol=1e-8)  # V = (cos t + sin t)/2
-    # a multiplier 1 all along (the X direction), the other e^(-T)
+    # a multiplier 1 all along (the X direction), then e^(-T), then W's e^((X - 5) T)
     mu = np.sort(fc.multiplier_abs.values, axis=1)
-    np.testing.assert_allclose(mu[:, 1], 1.0, atol=1e-7)
-    np.testing.assert_allclose(mu[:, 0], np.exp(-2 * np.pi), rtol=1e-6)
+    np.testing.assert_allclose(mu[:, 2], 1.0, atol=1e-7)
+    np.testing.assert_allclose(mu[:, 1], np.exp(-2 * np.pi), rtol=1e-6)
+    np.testing.assert_allclose(mu[:, 0], np.exp((X - 5) * 2 * np.pi), rtol=1e-3, atol=1e-12)
     # through the cusp onto the other fold: X from -1/sqrt(3) to positive, a changes sign
     assert X[0] == pytest.approx(-3 ** -0.5, abs=1e-8) and X[-1] > 0.5 and a[-1] < -0.3
     assert fc.attrs["status"] == "left the bounds of b"
     assert fc.sizes["cusp"] == 1
     assert abs(float(fc.cusp_a[0])) < 1e-4 and abs(float(fc.cusp_b[0])) < 2e-3
     assert fc.attrs["analysis"] == "fold_curve" and "param_a" not in fc.attrs
-    assert fc.sizes["codim2"] == 0  # the other multiplier, e^(-T), never crosses the circle
+    assert fc.sizes["codim2"] == 0  # the other multipliers never cross the circle
 
 
 def test_a_codimension_two_point_on_a_fold_curve_is_located_and_labelled():
     """With a third component W' = (X - c) W (W = 0 on the orbit, its multiplier
     e^((X - c) T)), the fold curve meets a second multiplier 1 where the fold's X is c: a 1:1
     resonance at (a, b) = (-2 c^3, 3 c^2), here c = 0.3: (-0.054, 0.27)."""
-    m = ns.model_from_equations(
-        "cusp_with_w", states=("X", "V", "W"),
-        parameters={"a": 0.3, "b": 1.0, "c": 0.3, "omega": 1.0},
-        modes={"free": ["a + b*X - X**3", "-V + cos(omega*t)", "(X - c)*W"]}, method="smooth",
-        forcing_amplitude=None)
-    p = m.params()
+    p = cusp_model().params(c=0.3)
     br = ns.continuation(p, "a", x0=-0.8, bounds=(0.3, 0.5), method="smooth", step=0.02)
     fc = ns.fold_curve(p, "a", "b", start=br, direction="down", step=0.02,
                        bounds=(-1.0, 1.0), bounds2=(-0.5, 1.5))
@@ -173,11 +175,8 @@ def test_the_grazing_curve_of_the_contact_free_orbit_is_its_closed_form():
         assert np.max(np.abs(F - np.sqrt((1 - w**2) ** 2 + (p.xi * w) ** 2))) < 1e-10
         assert np.max(np.abs(c.max_X.values - 1.0)) < 1e-10
         assert (F.max() > 0.5) if way == "up" else (F.min() < 0.05)
-    m = ns.model_from_equations("no_contact", states=("X", "V"),
-                                parameters={"a": 0.1, "omega": 1.0},
-                                modes={"free": ["V", "-X - a*V + cos(omega*t)"]}, method="smooth")
-    q = m.params()
+    q = cusp_model().params()  # a model without a contact level
     fake = br.copy()
-    fake.attrs.update(model="no_contact", method="smooth")
+    fake.attrs.update(model="cusp_with_w", method="smooth")
     with pytest.raises(ParameterError, match="declares no contact level"):
         ns.grazing_curve(q, "omega", "a", start=fake)

@@ -117,8 +117,10 @@ def test_a_manifold_point_mapped_by_the_kernel_lands_on_its_branch(fig7, method)
 
 
 def double_well():
+    """As tests/test_basin_entropy.py defines it (one compiled model for both files)."""
     return ns.model_from_equations(
-        "double_well", states=("X", "V"), parameters={"delta": 0.05, "F0": 0.03, "omega": 1.0},
+        "double_well", states=("X", "V"),
+        parameters={"delta": 0.15, "F0": 0.25, "omega": 1.0},
         modes={"free": ["V", "-delta*V + X - X**3 + F0*cos(omega*t)"]}, method="smooth")
 
 
@@ -127,7 +129,7 @@ def test_the_neimark_sacker_curve_of_an_orbit_in_a_well_is_zero_damping():
     (Liouville) and the orbit in a well has its complex pair on the unit circle exactly where
     delta = 0, whatever omega: the Neimark-Sacker curve in (delta, omega), continued both ways
     between the strong resonances, is delta = 0."""
-    p = double_well().params(omega=1.1)
+    p = double_well().params(delta=0.05, F0=0.03, omega=1.1)
     br = ns.continuation(p, "delta", x0=1.0, bounds=(-0.05, 0.05), direction="down",
                          method="smooth", step=0.02)
     assert br.special_type.values.tolist() == [3]
@@ -142,7 +144,7 @@ def test_the_neimark_sacker_curve_of_an_orbit_in_a_well_is_zero_damping():
 
 
 def test_the_first_homoclinic_tangency_of_the_double_well_is_melnikovs():
-    p = double_well().params()
+    p = double_well().params(delta=0.05, F0=0.03)
     orbit = ns.periodic_orbit(p, x0=-0.015, v0=0.0, method="smooth")
     assert orbit.attrs["converged"] == 1 and float(orbit.multiplier_abs[0]) > 400
     t = ns.homoclinic_tangency(p, orbit, "F0", (0.03, 0.045), tol=2e-4, x=(-2, 2),

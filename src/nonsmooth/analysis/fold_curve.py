@@ -334,6 +334,9 @@ def _special_curve(kind, params, param, param2, start, special, direction, step,
     if "section_moved" in start.attrs or "section" in start.attrs:
         raise ParameterError("start: a branch whose section moved, or of limit cycles, is not "
                              "supported here")
+    if kind == GRAZING and m.contact_level is None:
+        raise ParameterError(f"start: model {m.name} declares no contact level "
+                             f"(Model.contact_level): no grazing to follow")
     _, _, max_points, step, max_step, tol, lo, hi = branch_arguments(
         params, p1, 1, max_points, step, max_step, tol, direction, bounds, False)
     lo2, hi2 = branch_arguments(params, p2, 1, max_points, step, max_step, tol, direction,
@@ -349,9 +352,6 @@ def _special_curve(kind, params, param, param2, start, special, direction, step,
     params = params.replace(**{p1: l1})
     p0 = params.pack()
     if kind == GRAZING:
-        if m.contact_level is None:
-            raise ParameterError(f"start: model {m.name} declares no contact level "
-                                 f"(Model.contact_level): no grazing to follow")
         base = params
 
         def level(a, b):
