@@ -48,6 +48,7 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 import nonsmooth as ns
+from common import best_of
 from nonsmooth.kernels import Solver, new_state, output_buffers, run
 from nonsmooth.models.base import KERNEL_GENERIC
 
@@ -62,16 +63,6 @@ def case():
     return ns.preset("table3").replace(omega=0.92)
 
 
-def best_of(rounds, call):
-    """(best CPU seconds of ``rounds`` calls, the last result); ``call`` has been warmed up."""
-    best, out = math.inf, None
-    for _ in range(rounds):
-        t0 = time.process_time()
-        out = call()
-        best = min(best, time.process_time() - t0)
-    return best, out
-
-
 # ---- nonsmooth ------------------------------------------------------------------------------
 def time_simulate(params, method, periods, transient, rounds):
     """Plain trajectory through ``ns.simulate`` (specialised kernel), one sample per period."""
@@ -79,7 +70,7 @@ def time_simulate(params, method, periods, transient, rounds):
         return ns.simulate(params, periods=periods, transient=transient, method=method,
                            samples_per_period=1)
     call(periods=2, transient=1)  # warm-up: load / compile
-    return best_of(rounds, call)[0]
+    return best_of(rounds, call, time.process_time)[0]  # CPU seconds
 
 
 def time_generic(params, method, n, rounds):
@@ -94,7 +85,7 @@ def time_generic(params, method, n, rounds):
             raise RuntimeError(f"generic kernel, {method}: status {status}")
         return status
     call(n=5)  # warm-up: load / compile
-    return best_of(rounds, call)[0]
+    return best_of(rounds, call, time.process_time)[0]  # CPU seconds
 
 
 def time_lyapunov(lyapunov, params, method, periods, transient, rounds):
@@ -102,7 +93,7 @@ def time_lyapunov(lyapunov, params, method, periods, transient, rounds):
     def call(periods=periods, transient=transient):
         return lyapunov(params, periods=periods, transient=transient, method=method)
     call(periods=10, transient=1)  # warm-up: load / compile
-    return best_of(rounds, call)
+    return best_of(rounds, call, time.process_time)  # CPU seconds
 
 
 def spectrum_of(ds):

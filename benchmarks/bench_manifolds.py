@@ -23,21 +23,13 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 import nonsmooth as ns
+from common import best_of
 
 
 def double_well():
     return ns.model_from_equations(
         "double_well", states=("X", "V"), parameters={"delta": 0.05, "F0": 0.04, "omega": 1.0},
         modes={"free": ["V", "-delta*V + X - X**3 + F0*cos(omega*t)"]}, method="smooth")
-
-
-def timed(fn, repeat):
-    best, out = math.inf, None
-    for _ in range(repeat):
-        t0 = time.perf_counter()
-        out = fn()
-        best = min(best, time.perf_counter() - t0)
-    return best, out
 
 
 def main():
@@ -51,7 +43,7 @@ def main():
     for method in ("exact", "smooth"):
         orbit = ns.periodic_orbit(fig7, x0=-1.5, v0=0.25, method=method)
         ns.manifolds(fig7, orbit, x=(-3, 3), v=(-3, 3), length=1.0)  # compile / load
-        dt, ds = timed(lambda: ns.manifolds(fig7, orbit, x=(-3, 3), v=(-3, 3)), a.repeat)
+        dt, ds = best_of(a.repeat, lambda: ns.manifolds(fig7, orbit, x=(-3, 3), v=(-3, 3)))
         total += dt
         n = ds.attrs["periods_integrated"]
         print(f"fig7 saddle, {method}: {dt:.3f} s, {ds.sizes['point']} points, {n} periods, "
@@ -61,7 +53,7 @@ def main():
     orbit = ns.periodic_orbit(p, x0=-0.02, v0=0.0, method="smooth")
     kw = dict(x=(-2, 2), v=(-1.5, 1.5), length=5.0)
     ns.manifolds(p, orbit, **{**kw, "length": 0.5})
-    dt, ds = timed(lambda: ns.manifolds(p, orbit, **kw), a.repeat)
+    dt, ds = best_of(a.repeat, lambda: ns.manifolds(p, orbit, **kw))
     total += dt
     n = ds.attrs["periods_integrated"]
     rate = n / dt

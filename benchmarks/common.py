@@ -61,3 +61,13 @@ def cpu_timer():
 def machine_line() -> str:
     load = os.getloadavg()
     return f"cpus={os.cpu_count()} load(1m,5m)={load[0]:.2f},{load[1]:.2f}"
+
+
+def best_of(rounds, call, clock=time.perf_counter):
+    """(best ``clock`` seconds of ``rounds`` calls of ``call``, the last result)."""
+    best, out = float("inf"), None
+    for _ in range(rounds):
+        t0 = clock()
+        out = call()
+        best = min(best, clock() - t0)
+    return best, out

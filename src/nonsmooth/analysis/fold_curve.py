@@ -67,9 +67,13 @@ class _FoldBranch:
         """(P(z) - z, M, g, start state) or None."""
         p = self.p(l1, l2)
         s0 = _section_state(self.setup, p, z, self.template)
-        s1, M, code, _ = period_map(self.setup, p, s0, self.k)
+        s1, M, code, bufs = period_map(self.setup, p, s0, self.k)
         if code != st.OK:
             return None
+        return self.setup.z_of(s1) - z, M, self._test(M, bufs, l1, l2), s0
+
+    def _test(self, M, bufs, l1, l2):
+        """The curve's test function g at a point (monodromy M, the period's outputs)."""
         act = _active(M, self.setup.n)
         Ma = M[np.ix_(act, act)]
         if self.mu is None:  # Neimark-Sacker: a pair of multipliers with product 1
@@ -78,10 +82,8 @@ class _FoldBranch:
             for i in range(len(ev)):
                 for j in range(i + 1, len(ev)):
                     g *= ev[i] * ev[j] - 1.0
-            g = float(np.real(g))
-        else:
-            g = float(np.linalg.det(Ma - self.mu * np.eye(len(Ma))))
-        return self.setup.z_of(s1) - z, M, g, s0
+            return float(np.real(g))
+        return float(np.linalg.det(Ma - self.mu * np.eye(len(Ma))))
 
     def _ends(self, z, l1, l2, s0):
         s = _section_state(self.setup, self.p(l1, l2), z, s0)
@@ -169,14 +171,8 @@ class _GrazingBranch(_FoldBranch):
         super().__init__(setup, p0, i1, i2, k, tol)
         self.level = level  # (l1, l2) -> the contact level there
 
-    def _map(self, z, l1, l2):
-        p = self.p(l1, l2)
-        s0 = _section_state(self.setup, p, z, self.template)
-        s1, M, code, bufs = period_map(self.setup, p, s0, self.k)
-        if code != st.OK:
-            return None
-        g = float(np.max(bufs[4])) - self.level(l1, l2)
-        return self.setup.z_of(s1) - z, M, g, s0
+    def _test(self, M, bufs, l1, l2):
+        return float(np.max(bufs[4])) - self.level(l1, l2)
 
 
 #: codimension-two points on a curve: (kind of curve, test crossing zero) -> name. The tests,

@@ -222,39 +222,46 @@ def plot_continuation(ds, var: str = "max_X", ax=None):
     return fig
 
 
-def plot_two_parameter(ds, ax=None):
-    """A two-parameter curve (``analysis.continuation.two_parameter_curve``): the special
-    points' first parameter versus the second, one line per point of the branch."""
-    param, param2 = ds.attrs["param"], ds.attrs["param2"]
+def _parameter_plane(ds, ax):
+    """(fig, ax, model, param, param2) of a figure in the plane of a result's two parameters
+    (attrs ``param``, ``param2``)."""
     if ax is None:
         fig, ax = new_figure(figsize=(7, 5))
     else:
         fig = ax.figure
-    m = model_of(ds)
-    y = ds[param2].values
-    for j in range(ds.sizes["n"]):
-        ax.plot(ds[param].values[:, j], y, marker=".", lw=1.2, label=f"{ds.attrs['special']} #{j}")
+    return fig, ax, model_of(ds), ds.attrs["param"], ds.attrs["param2"]
+
+
+def _finish_plane(fig, ax, ds, m, param, param2, title):
     ax.set_xlabel(f"{param_symbol(m, param)} [{ds[param].attrs.get('units', '')}]")
     ax.set_ylabel(f"{param_symbol(m, param2)} [{ds[param2].attrs.get('units', '')}]")
-    ax.set_title(f"{ds.attrs['special']} points in ({param}, {param2})", fontsize=10)
+    ax.set_title(title, fontsize=10)
     ax.grid(True, lw=0.3, alpha=0.5)
     ax.legend(fontsize=8)
     fig.tight_layout()
     return fig
 
 
+def plot_two_parameter(ds, ax=None):
+    """A two-parameter curve (``analysis.continuation.two_parameter_curve``): the special
+    points' first parameter versus the second, one line per point of the branch."""
+    fig, ax, m, param, param2 = _parameter_plane(ds, ax)
+    y = ds[param2].values
+    for j in range(ds.sizes["n"]):
+        ax.plot(ds[param].values[:, j], y, marker=".", lw=1.2, label=f"{ds.attrs['special']} #{j}")
+    return _finish_plane(fig, ax, ds, m, param, param2,
+                         f"{ds.attrs['special']} points in ({param}, {param2})")
+
+
 def plot_special_curve(ds, ax=None):
-    """A fold, period-doubling or grazing curve continued as an extended system
-    (``fold_curve``, ``period_doubling_curve``, ``grazing_curve``): the first parameter versus the second, its
-    start (o), its cusps (x) and its other codimension-two points (diamonds)."""
-    param, param2 = ds.attrs["param"], ds.attrs["param2"]
-    if ax is None:
-        fig, ax = new_figure(figsize=(7, 5))
-    else:
-        fig = ax.figure
-    m = model_of(ds)
+    """A fold, period-doubling, grazing or Neimark-Sacker curve continued as an extended
+    system (``fold_curve``, ``period_doubling_curve``, ``grazing_curve``,
+    ``neimark_sacker_curve``): the first parameter versus the second, its start (o), its cusps
+    (x) and its other codimension-two points (diamonds)."""
+    fig, ax, m, param, param2 = _parameter_plane(ds, ax)
     what = {"fold_curve": "fold", "period_doubling_curve": "period doubling",
-            "grazing_curve": "grazing", "neimark_sacker_curve": "Neimark-Sacker"}.get(ds.attrs.get("analysis"), "special point")
+            "grazing_curve": "grazing", "neimark_sacker_curve": "Neimark-Sacker"}.get(
+                ds.attrs.get("analysis"), "special point")
     ax.plot(ds[param].values, ds[param2].values, "-", color="k", lw=1.3, label=f"{what} curve")
     ax.plot(ds[param].values[0], ds[param2].values[0], "o", mfc="none", mec="k",
             label="start (on the branch)")
@@ -266,11 +273,5 @@ def plot_special_curve(ds, ax=None):
         for i in range(ds.sizes["codim2"]):
             ax.plot(float(ds["codim2_" + param][i]), float(ds["codim2_" + param2][i]), "D",
                     mfc="none", ms=8, label=names[int(ds["codim2_type"][i])].replace("_", " "))
-    ax.set_xlabel(f"{param_symbol(m, param)} [{ds[param].attrs.get('units', '')}]")
-    ax.set_ylabel(f"{param_symbol(m, param2)} [{ds[param2].attrs.get('units', '')}]")
-    ax.set_title(f"{what} continued in ({param}, {param2}): {ds.attrs.get('status', '')}",
-                 fontsize=10)
-    ax.grid(True, lw=0.3, alpha=0.5)
-    ax.legend(fontsize=8)
-    fig.tight_layout()
-    return fig
+    return _finish_plane(fig, ax, ds, m, param, param2,
+                         f"{what} continued in ({param}, {param2}): {ds.attrs.get('status', '')}")
