@@ -27,6 +27,7 @@ from . import continuation  # noqa: E402,F401
 from . import parameter_map  # noqa: E402,F401
 from . import autonomous  # noqa: E402,F401
 from . import manifolds  # noqa: E402,F401
+from . import explore  # noqa: E402,F401
 
 def _terminate(signum, frame):
     raise Terminated()

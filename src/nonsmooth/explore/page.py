@@ -1,0 +1,450 @@
+"""The explore page: a Bokeh document with a field and a slider per parameter, the method, the
+initial condition, and three linked panels (time response by mode, phase portrait with the
+section points, an orbit-diagram slice that fills in progressively). Computations run in
+background threads (``compute.LatestWorker``): a newer request supersedes an older one.
+"""
+
+from __future__ import annotations
+
+import math
+import shlex
+from functools import partial
+
+import numpy as np
+
+from ..errors import NonsmoothError, ParameterError
+from . import compute
+
+#: Steps of a slider; the text field beside it takes any value in range.
+SLIDER_STEPS = 400
+#: Default number of values of the orbit-diagram slice.
+SLICE_VALUES = 200
+#: Colour of each mode (as the figures of nonsmooth.plot).
+MODE_COLORS = ("#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564b", "#e377c2",
+               "#17becf")
+
+
+def slider_range(prm, value: float) -> tuple[float, float]:
+    """A slider's (start, end) for parameter ``prm`` around ``value``: the parameter's own
+    bounds where finite, else a range around the value (a decade for a positive parameter)."""
+    lo = prm.low if math.isfinite(prm.low) else None
+    hi = prm.high if math.isfinite(prm.high) else None
+    span = max(abs(value), 1.0)
+    if lo is None:
+        lo = value - span if value <= 0 or (hi is not None and hi <= 0) else 0.0
+    if hi is None:
+        hi = max(2.0 * value, lo + span) if value > 0 else value + span
+    if hi - lo > 20 * span and value > 0 and lo >= 0:      # e.g. 0 < omega_s < inf
+        hi = max(4.0 * value, lo + span)
+    return float(lo), float(hi)
+
+
+def _fmt(v: float) -> str:
+    return f"{v:.10g}"
+
+
+class Explorer:
+    """One page (one Bokeh session): its widgets, figures and workers."""
+
+    def __init__(self, doc, model="support", method=None, preset=None, sets=None,
+                 show=None, slice_param=None):
+        from bokeh.models import Div
+
+        self.doc = doc
+        self.model = None
+        self.values: dict[str, float] = {}
+        self.method = method
+        self.u0: list[float] = []
+        self.pair = (0, 1)
+        self._show_names = show
+        self.message = Div(text="", name="message", styles={"color": "#b00020"})
+        self._view_worker = compute.LatestWorker(self._compute_view, self._deliver(self._show_view),
+                                                 "explore-view")
+        self._slice_worker = compute.LatestWorker(self._compute_slice,
+                                                  self._deliver(self._show_slice), "explore-slice")
+        self._build_static()
+        self.load_model(model, method=method, preset=preset, sets=sets, slice_param=slice_param)
+        doc.add_root(self.layout)
+        doc.title = "nonsmooth explore"
+        doc.on_session_destroyed(lambda ctx: self.stop())
+
+    # ---- workers ------------------------------------------------------------------------------
+    def stop(self) -> None:
+        self._view_worker.stop()
+        self._slice_worker.stop()
+
+    def _deliver(self, apply):
+        def deliver(gen, value):
+            self.doc.add_next_tick_callback(partial(apply, gen, value))
+        return deliver
+
+    def _params(self):
+        return self.model.params(**self.values)
+
+    def _compute_view(self, params, method, u0, alive):
+        with compute.COMPUTE_LOCK:
+            if not alive():
+                raise compute.Cancelled()
+            return compute.current_orbit(params, method, u0)
+
+    def _compute_slice(self, params, method, param, values, u0, alive):
+        return compute.orbit_slice(params, method, param, values, u0, alive=alive,
+                                   component=self.model.state_names[self.pair[0]])
+
+    # ---- layout -------------------------------------------------------------------------------
+    def _build_static(self):
+        from bokeh.layouts import column, row
+        from bokeh.models import (Button, ColumnDataSource, Div, Select, Span, TextInput,
+                                  TextAreaInput)
+        from bokeh.plotting import figure
+
+        self.model_input = TextInput(title="model (built-in name or path/to/file.py:NAME)",
+                                     name="model", width=330)
+        self.model_input.on_change("value", lambda a, o, n: self._on_model(n))
+        self.method_select = Select(title="method", name="method", width=160)
+        self.method_select.on_change("value", lambda a, o, n: self._on_method(n))
+        self.params_box = column(name="parameters")
+        self.u0_box = column(name="initial_condition")
+        self.status = Div(text="", name="status", width=520)
+        self.modes = Div(text="", name="modes", width=520)
+        self.slice_status = Div(text="", name="slice_status", width=520)
+
+        tools = "pan,wheel_zoom,box_zoom,reset,tap"
+        self.time_src = ColumnDataSource(dict(t=[], a=[], color=[]), name="time_source")
+        self.orbit_src = ColumnDataSource(dict(a=[], b=[], color=[]), name="orbit_source")
+        self.section_src = ColumnDataSource(dict(a=[], b=[]), name="section_source")
+        self.slice_src = ColumnDataSource(dict(value=[], point=[]), name="slice_source")
+        self.time_fig = figure(title="time response", height=300, width=560, tools=tools,
+                               x_axis_label="t", name="time_response")
+        self.time_fig.line("t", "a", source=self.time_src, color="#999999")
+        self.time_fig.scatter("t", "a", source=self.time_src, color="color", size=3)
+        self.phase_fig = figure(title="phase portrait and section (click: initial condition)",
+                                height=300, width=460, tools=tools, name="phase_portrait")
+        self.phase_fig.line("a", "b", source=self.orbit_src, color="#999999")
+        self.phase_fig.scatter("a", "b", source=self.orbit_src, color="color", size=3)
+        self.phase_fig.scatter("a", "b", source=self.section_src, color="black", size=5,
+                               marker="circle", legend_label="section")
+        self.phase_fig.legend.location = "top_left"
+        self.slice_fig = figure(title="orbit diagram (click: set the parameter)", height=300,
+                                width=1030, tools=tools, name="orbit_diagram")
+        self.slice_fig.scatter("value", "point", source=self.slice_src, size=2, color="black")
+        self.slice_marker = Span(dimension="height", location=0.0, line_color="#d62728",
+                                 line_dash="dashed")
+        self.slice_fig.add_layout(self.slice_marker)
+        self.level_spans = []
+        from bokeh.events import Tap
+        self.phase_fig.on_event(Tap, self._on_phase_tap)
+        self.slice_fig.on_event(Tap, self._on_slice_tap)
+
+        self.slice_param = Select(title="orbit diagram over", name="slice_param", width=160)
+        self.slice_lo = TextInput(title="from", name="slice_from", width=110)
+        self.slice_hi = TextInput(title="to", name="slice_to", width=110)
+        self.slice_n = TextInput(title="values", name="slice_values", value=str(SLICE_VALUES),
+                                 width=80)
+        for w in (self.slice_lo, self.slice_hi, self.slice_n):
+            w.on_change("value", lambda a, o, n: self.request_slice())
+        self.slice_param.on_change("value", lambda a, o, n: self._on_slice_param(n))
+
+        self.export_button = Button(label="export", name="export", width=100)
+        self.export_button.on_click(self.export)
+        self.export_text = TextAreaInput(title="command line and Python snippet", rows=8,
+                                         width=1030, name="export_text")
+        head = Div(text="<b>nonsmooth explore</b>", width=200)
+        controls = column(head, self.model_input, self.method_select, self.params_box,
+                          Div(text="<b>initial condition</b>"), self.u0_box, self.message,
+                          width=350)
+        panels = column(
+            self.modes, row(self.time_fig, self.phase_fig), self.status,
+            row(self.slice_param, self.slice_lo, self.slice_hi, self.slice_n), self.slice_status,
+            self.slice_fig, row(self.export_button), self.export_text)
+        self.layout = row(controls, panels)
+
+    # ---- the model and its widgets ------------------------------------------------------------
+    def load_model(self, name, method=None, preset=None, sets=None, slice_param=None) -> bool:
+        """Show ``name``'s parameters; on failure the page says why in one line and keeps the
+        model it had."""
+        from ..models import model as get_model
+
+        try:
+            m = get_model(name)
+            params = m.preset(preset) if preset else m.params()
+            if sets:
+                params = params.replace(**sets)
+            if method is not None and method not in m.methods:
+                raise ParameterError(f"method: {method!r} is not a method of {m.name} "
+                                     f"({', '.join(m.methods)})")
+        except (NonsmoothError, TypeError, ValueError) as exc:
+            self.message.text = f"model {name}: {str(exc).splitlines()[0]}"
+            self.model_input.value = self.model_name if self.model is not None else str(name)
+            return False
+        self.message.text = ""
+        self.model, self.model_name = m, str(name)
+        self.values = dict(params.as_dict())
+        self.method = method or ("smooth" if "smooth" in m.methods else next(iter(m.methods)))
+        self.u0 = [0.0] * len(m.state_names)
+        names = m.state_names
+        if self._show_names:
+            a, b = self._show_names
+            self.pair = (names.index(a), names.index(b))
+        else:
+            self.pair = (0, 1)
+        self.model_input.value = str(name)
+        self.modes.text = "modes: " + " ".join(
+            f"<span style='color:{MODE_COLORS[k % len(MODE_COLORS)]}'>&#9632;</span> {nm}"
+            for k, nm in enumerate(m.mode_names))
+        self.method_select.options = list(m.methods)
+        self.method_select.value = self.method
+        self._build_param_widgets()
+        self._build_u0_widgets()
+        self.time_fig.yaxis.axis_label = names[self.pair[0]]
+        self.phase_fig.xaxis.axis_label = names[self.pair[0]]
+        self.phase_fig.yaxis.axis_label = names[self.pair[1]]
+        self.slice_fig.yaxis.axis_label = f"{names[self.pair[0]]} on the section"
+        opts = list(m.param_names)
+        default = slice_param or m.forcing_param or opts[0]
+        self.slice_param.options = opts
+        self._set_slice_param(default if default in opts else opts[0])
+        self.request_view()
+        return True
+
+    def _build_param_widgets(self):
+        from bokeh.layouts import row
+        from bokeh.models import Slider, TextInput
+
+        self.fields, self.sliders = {}, {}
+        rows = []
+        for prm in self.model.parameters:
+            v = self.values[prm.name]
+            lo, hi = slider_range(prm, v)
+            label = f"{prm.name} [{prm.units}]" if prm.units not in ("", "1") else prm.name
+            field = TextInput(title=label, value=_fmt(v), name=f"param_{prm.name}", width=120)
+            slider = Slider(start=lo, end=hi, value=min(max(v, lo), hi),
+                            step=(hi - lo) / SLIDER_STEPS, title="", show_value=False,
+                            name=f"slider_{prm.name}", width=200)
+            field.on_change("value", partial(self._on_field, prm))
+            slider.on_change("value_throttled", partial(self._on_slider, prm))
+            self.fields[prm.name], self.sliders[prm.name] = field, slider
+            rows.append(row(field, slider))
+        self.params_box.children = rows
+
+    def _build_u0_widgets(self):
+        from bokeh.models import TextInput
+
+        self.u0_fields = []
+        for i, nm in enumerate(self.model.state_names):
+            w = TextInput(title=f"{nm}(0)", value=_fmt(self.u0[i]), name=f"u0_{nm}", width=120)
+            w.on_change("value", partial(self._on_u0, i))
+            self.u0_fields.append(w)
+        self.u0_box.children = list(self.u0_fields)
+
+    # ---- events -------------------------------------------------------------------------------
+    def _on_model(self, name):
+        if self.model is not None and name == self.model_name:
+            return
+        self.load_model(name.strip())
+
+    def _on_method(self, name):
+        if name and name != self.method:
+            self.method = name
+            self.request_view()
+            self.request_slice()
+
+    def _label(self, prm):
+        return f"{prm.name} [{prm.units}]" if prm.units not in ("", "1") else prm.name
+
+    def _on_field(self, prm, attr, old, new):
+        field = self.fields[prm.name]
+        try:
+            v = prm.check(new.strip())
+            self.model.validate({**self.values, prm.name: v})
+        except ParameterError as exc:
+            field.title = f"⚠ {str(exc).splitlines()[0]}"
+            return
+        field.title = self._label(prm)
+        self.set_param(prm.name, v, from_field=True)
+
+    def _on_slider(self, prm, attr, old, new):
+        self.fields[prm.name].value = _fmt(float(new))    # validated by the field
+
+    def _on_u0(self, i, attr, old, new):
+        w = self.u0_fields[i]
+        nm = self.model.state_names[i]
+        try:
+            v = float(new)
+            if not math.isfinite(v):
+                raise ValueError
+        except ValueError:
+            w.title = f"⚠ {nm}(0): expected a finite number, got {new!r}"
+            return
+        w.title = f"{nm}(0)"
+        if v != self.u0[i]:
+            self.u0[i] = v
+            self.request_view()
+            self.request_slice()
+
+    def _on_phase_tap(self, event):
+        a, b = self.pair
+        self.u0_fields[a].value = _fmt(float(event.x))
+        self.u0_fields[b].value = _fmt(float(event.y))
+
+    def _on_slice_tap(self, event):
+        name = self.slice_param.value
+        self.fields[name].value = _fmt(float(event.x))
+
+    def _on_slice_param(self, name):
+        if name:
+            self._set_slice_param(name)
+
+    def _set_slice_param(self, name):
+        prm = self.model.param(name)
+        v = self.values[name]
+        lo, hi = slider_range(prm, v)
+        if self.model.forcing_param == name and v > 0:
+            lo, hi = 0.8 * v, 1.2 * v
+        self.slice_param.value = name
+        self.slice_lo.value, self.slice_hi.value = _fmt(lo), _fmt(hi)
+        self.slice_fig.xaxis.axis_label = name
+        self.slice_marker.location = v
+        self.request_slice()
+
+    def set_param(self, name: str, value: float, from_field: bool = False):
+        """Set a parameter (validated by the caller) and recompute what depends on it."""
+        if self.values.get(name) == value:
+            return
+        self.values[name] = value
+        if not from_field:
+            self.fields[name].value = _fmt(value)
+        s = self.sliders[name]
+        if not s.start <= value <= s.end:
+            lo, hi = min(s.start, value), max(s.end, value)
+            s.update(start=lo, end=hi, step=(hi - lo) / SLIDER_STEPS)
+        s.value = value
+        if name == self.slice_param.value:
+            self.slice_marker.location = value
+        self.request_view()
+        if name != self.slice_param.value:
+            self.request_slice()
+
+    # ---- requests and results -----------------------------------------------------------------
+    def request_view(self):
+        """Recompute the current orbit (the newest request wins)."""
+        try:
+            params = self._params()
+        except ParameterError as exc:
+            self.status.text = f"⚠ {exc}"
+            return
+        self.status.text = "computing ..."
+        self._view_worker.submit(params, self.method, list(self.u0))
+
+    def request_slice(self):
+        """Recompute the orbit-diagram slice (cleared, then filled chunk by chunk)."""
+        if self.model is None or not self.slice_param.value:
+            return
+        name = self.slice_param.value
+        prm = self.model.param(name)
+        try:
+            lo, hi = prm.check(self.slice_lo.value), prm.check(self.slice_hi.value)
+            n = int(self.slice_n.value)
+            if not 2 <= n <= 5000:
+                raise ParameterError(f"values: between 2 and 5000, got {n}")
+            if not hi > lo:
+                raise ParameterError(f"slice: 'to' must be above 'from' ({lo:g} .. {hi:g})")
+            params = self._params()
+        except (ParameterError, ValueError) as exc:
+            self.slice_status.text = f"⚠ {str(exc).splitlines()[0]}"
+            return
+        self.slice_src.data = dict(value=[], point=[])
+        self._slice_total = n
+        self._slice_done = 0
+        self.slice_status.text = f"orbit diagram: 0 of {n} values"
+        self._slice_gen = self._slice_worker.submit(params, self.method, name,
+                                                    np.linspace(lo, hi, n), list(self.u0))
+
+    def _show_view(self, gen, orbit):
+        if not self._view_worker.alive(gen):
+            return
+        if isinstance(orbit, Exception):
+            self.status.text = f"failed: {str(orbit).splitlines()[0] if str(orbit) else orbit!r}"
+            return
+        names = self.model.state_names
+        a, b = (names[i] for i in self.pair)
+        colors = [MODE_COLORS[int(m) % len(MODE_COLORS)] for m in orbit.mode]
+        self.time_src.data = dict(t=orbit.t, a=orbit.u.get(a, []), color=colors)
+        self.orbit_src.data = dict(a=orbit.u.get(a, []), b=orbit.u.get(b, []), color=colors)
+        self.section_src.data = dict(a=orbit.section.get(a, []), b=orbit.section.get(b, []))
+        self._draw_levels()
+        self.status.text = (f"{orbit.summary()} <span style='color:#888'>"
+                            f"({1000 * orbit.seconds:.0f} ms)</span>")
+
+    def _draw_levels(self):
+        from bokeh.models import Span
+
+        for s in self.level_spans:
+            s.visible = False
+        if self.pair[0] != 0:
+            return
+        try:
+            lines = self.model.plot_lines(self._params(), self.method)
+        except Exception:  # noqa: BLE001 - decoration only
+            lines = []
+        for k, (level, _label) in enumerate(lines[:4]):
+            if k >= len(self.level_spans):
+                spans = (Span(dimension="width", line_color="#555555", line_dash="dotted"),
+                         Span(dimension="height", line_color="#555555", line_dash="dotted"))
+                self.time_fig.add_layout(spans[0])
+                self.phase_fig.add_layout(spans[1])
+                self.level_spans.extend(spans)
+            for s in self.level_spans[2 * k:2 * k + 2]:
+                s.location, s.visible = float(level), True
+
+    def _show_slice(self, gen, part):
+        if not self._slice_worker.alive(gen):
+            return
+        if isinstance(part, Exception):
+            self.slice_status.text = f"orbit diagram failed: {str(part).splitlines()[0]}"
+            return
+        values, pts, _period = part
+        vv = np.repeat(values, pts.shape[1])
+        pp = pts.reshape(-1)
+        ok = np.isfinite(pp)
+        self.slice_src.stream(dict(value=vv[ok], point=pp[ok]))
+        self._slice_done += len(values)
+        done = self._slice_done >= self._slice_total
+        self.slice_status.text = (f"orbit diagram: {self._slice_done} of {self._slice_total} "
+                                  f"values{' (complete)' if done else ''}")
+
+    # ---- export -------------------------------------------------------------------------------
+    def export(self):
+        """The current parameters as a ``nonsmooth`` command line and a Python snippet."""
+        self.export_text.value = export_text(self.model_name, self.model, self.values,
+                                             self.method, self.u0)
+
+
+def export_text(model_name: str, model, values: dict, method: str, u0) -> str:
+    """A command line (``nonsmooth poincare ...``) and a Python snippet for these settings."""
+    sets = " ".join(f"--set {k}={_fmt(v)}" for k, v in values.items())
+    names = model.state_names
+    u0_arg = ",".join(f"{n}={_fmt(x)}" for n, x in zip(names, u0))
+    forced = not model.autonomous and (model.forcing_amplitude is None
+                                       or values.get(model.forcing_amplitude, 1.0) != 0.0)
+    cmd = "poincare --record 200 --transient 200" if forced else "simulate --periods 20"
+    line = (f"nonsmooth {cmd} --model {shlex.quote(model_name)} --method {method} {sets} "
+            f"--u0 {u0_arg} -o explore.nc --plot explore.png")
+    kw = ", ".join(f"{k}={_fmt(v)}" for k, v in values.items())
+    call = ("ns.poincare(p, record=200, transient=200" if forced else
+            "ns.simulate(p, periods=20")
+    py = (f"import nonsmooth as ns\n\n"
+          f"p = ns.model({model_name!r}).params({kw})\n"
+          f"ds = {call}, method={method!r}, u0={[float(x) for x in u0]!r})\n")
+    return f"{line}\n\n{py}"
+
+
+def make_document(doc, model="support", method=None, preset=None, sets=None, show=None,
+                  slice_param=None) -> Explorer:
+    """Build the explore page in the Bokeh document ``doc`` (a Bokeh server application's
+    document): ``model`` a built-in name or ``path/to/file.py:NAME``, its ``method``,
+    ``preset`` and parameter overrides ``sets`` ({name: value}), the two state components to
+    ``show`` (names) and the parameter of the orbit-diagram slice (default: the forcing
+    frequency)."""
+    return Explorer(doc, model=model, method=method, preset=preset, sets=sets, show=show,
+                    slice_param=slice_param)
