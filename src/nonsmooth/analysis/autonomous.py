@@ -229,7 +229,7 @@ def surface_section(params, section="V", *, crossings: int = 200, transient: int
     docstring) in its direction. Returns a Dataset over ``crossing`` with the state (``X``,
     ``V`` and one variable per further component, ``io.components(ds)``), the time ``t`` since the last transient crossing and the
     ``return_time`` from the crossing before; scalars ``cycle_crossings`` (the smallest q <= 16
-    with u repeating after q crossings to 1e-6 (1 + |u|); 0: none), ``cycle_period`` (the
+    with u repeating after q crossings to 1e-6 (1 + ‖u‖); 0: none), ``cycle_period`` (the
     time of those q crossings; NaN: none) and ``at_equilibrium`` (the crossings converge onto
     an equilibrium, a focus: no cycle). A surface the orbit stops crossing within
     ``max_time`` (per call: the transient, then the record) raises a one-line
@@ -274,7 +274,7 @@ def surface_section(params, section="V", *, crossings: int = 200, transient: int
 
 def _repetition(flow, s, U, Tc):
     """(q, cycle period, at rest) of recorded crossings U at times Tc, the state ``s`` after
-    the last: the smallest q <= 16 with U repeating after q crossings to 1e-6 (1 + |U|) (0:
+    the last: the smallest q <= 16 with U repeating after q crossings to 1e-6 (1 + ‖U‖) (0:
     none; NaN period), and whether they converge onto an equilibrium (the field vanishes at
     ``s`` to 1e-6: a focus, whose crossings repeat too but are no cycle)."""
     crossings = len(U)
@@ -398,7 +398,7 @@ def limit_cycle(params, section="V", *, x0: float = 0.0, v0: float = 0.0, u0=Non
     Returns a Dataset: ``period``, the section point (``X_section``, ``V_section``, ...), the
     nontrivial
     Floquet multipliers ``multiplier_real``/``_imag``/``_abs`` (n - 1 of them, largest modulus
-    first; the trivial 1 is removed), ``stable`` (all |mu| < 1 - 1e-6), ``max_X``, ``min_X``
+    first; the trivial 1 is removed), ``stable`` (all ‖mu‖ < 1 - 1e-6), ``max_X``, ``min_X``
     and the cycle sampled at ``samples`` points (``X``, ``V``, ... and ``mode`` over ``t``);
     attrs
     ``status`` ("converged", "max_iter", "diverged", "singular", "no crossing: ...",

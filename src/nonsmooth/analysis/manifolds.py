@@ -467,7 +467,7 @@ def manifolds(params, orbit, *, x=None, v=None, spacing: float | None = None,
 
     ``x``, ``v``: the window (X and V ranges) the branches are grown in (default: none, then
     ``length`` bounds them); ``spacing``: the largest distance between consecutive points,
-    to a few per cent (default: 1/200 of the window's diagonal, else 0.01 (1 + |z*|)); ``delta``: the distance
+    to a few per cent (default: 1/200 of the window's diagonal, else 0.01 (1 + ‖z*‖)); ``delta``: the distance
     of the first point from the saddle (default spacing / 1000); ``max_angle``: the largest
     turn (radians) at a point before it is refined; ``length``: the largest arc length of a
     branch (default 4 window diagonals, else 100 spacings); ``iterates``: the most

@@ -221,12 +221,12 @@ def periodic_orbit(params, *, k: int = 1, x0: float = 0.0, v0: float = 0.0,
     ``transient`` periods).
 
     Newton's iteration on F(z) = P^k(z) - z with the monodromy M = dP^k/dz from the tangent
-    kernel (F' = M - I): quadratic convergence; a step that does not reduce |F| is halved up
-    to 12 times (damped Newton). Converged when |F| <= tol (1 + |z|).
+    kernel (F' = M - I): quadratic convergence; a step that does not reduce ‖F‖ is halved up
+    to 12 times (damped Newton). Converged when ‖F‖ <= tol (1 + ‖z‖).
 
     Returns a Dataset: the section points ``X_section``, ``V_section`` (k of them, ``point``),
     the Floquet multipliers ``multiplier_real`` / ``multiplier_imag`` and ``multiplier_abs``
-    (largest modulus first), ``stable`` (all |mu| < 1), ``max_X``, ``min_X`` over the orbit
+    (largest modulus first), ``stable`` (all ‖mu‖ < 1), ``max_X``, ``min_X`` over the orbit
     (interior extrema), ``contact_fraction`` (fraction of the orbit's samples in the model's
     contact modes), the orbit itself (``X``, ``V``, ``mode`` over ``t``, one period k T at
     ``samples_per_period`` per period; a model with more state components has one variable
@@ -234,7 +234,7 @@ def periodic_orbit(params, *, k: int = 1, x0: float = 0.0, v0: float = 0.0,
     "diverged", "integration failed: ...", "singular", "not confirmed: ..."), ``iterations``,
     ``residual`` and ``confirmation_residual``: a converged orbit is integrated once more,
     sampled ``samples_per_period`` times a period (so with other steps than Newton's), and is
-    reported converged only if it closes on itself to ``CONFIRM_TOL`` (1 + |z|).
+    reported converged only if it closes on itself to ``CONFIRM_TOL`` (1 + ‖z‖).
     Bad input raises one-line ParameterErrors; a failed search is a status, not an error."""
     from ..simulate import check_forced
     check_forced(params, "periodic_orbit")
