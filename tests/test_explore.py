@@ -24,7 +24,7 @@ import pytest
 
 import nonsmooth as ns
 from nonsmooth.explore import compute
-from nonsmooth.explore.page import export_text, slider_range
+from nonsmooth.explore.page import export_text, slice_range, slider_range
 
 LIMIT = 300.0  # safety limit of every wait (s): never reached when things work
 CHROMIUM = shutil.which("chromium") or shutil.which("chromium-browser")
@@ -43,13 +43,25 @@ def wait_for(predicate, what: str, limit: float = LIMIT):
 
 
 # ---- what the page computes --------------------------------------------------------------------
-def test_slider_ranges_follow_the_parameters():
+def test_slider_and_slice_ranges_are_allowed_by_the_model():
     m = ns.model("support")
-    assert slider_range(m.param("eta"), 1e-5) == (0.0, 0.5)          # 0 < eta < 0.5
-    lo, hi = slider_range(m.param("omega"), 0.91)                     # omega > 0, unbounded
-    assert lo == 0.0 and hi >= 2 * 0.91
-    lo, hi = slider_range(m.param("F0"), 0.3)
-    assert lo <= 0.3 <= hi
+    for name, v in (("eta", 1e-5), ("omega", 0.91), ("F0", 0.3), ("xi", 0.05)):
+        prm = m.param(name)
+        lo, hi = slider_range(prm, v)
+        assert lo <= v <= hi or name == "eta"   # eta: the field sets what the slider can't
+        prm.check(lo), prm.check(hi)      # open ends moved in: both ends allowed
+    assert slider_range(m.param("eta"), 1e-5) == (0.5 / 400, 0.5 - 0.5 / 400)
+    # the slice's default range passes the cross-field rules too: support needs xi_s = 0
+    # where omega_s = 0, stick_slip mu_s >= mu_k
+    values = ns.preset("table3").as_dict()
+    lo, hi = slice_range(m, values, "omega_s")
+    assert lo < values["omega_s"] < hi
+    m.validate({**values, "omega_s": lo}), m.validate({**values, "omega_s": hi})
+    ss = ns.model("stick_slip")
+    sv = ss.preset("stribeck").as_dict()
+    lo, hi = slice_range(ss, sv, "mu_s")
+    assert lo < sv["mu_s"] < hi
+    ss.validate({**sv, "mu_s": lo})
 
 
 def test_current_orbit_matches_poincare_and_reports_failures():
@@ -70,11 +82,25 @@ def test_current_orbit_matches_poincare_and_reports_failures():
     assert bad.status.startswith("failed: ") and "\n" not in bad.status
 
 
+def test_the_orbit_is_drawn_before_its_lambda1():
+    p = ns.preset("table3").replace(omega=0.92)
+    first, second = compute.orbit_stages(p, "exact", [0.0, 0.0])
+    assert first.lambda1_pending and "λ1: computing" in first.summary()
+    assert math.isnan(first.lambda1)
+    full = compute.current_orbit(p, "exact", [0.0, 0.0])
+    assert not second.lambda1_pending and second.lambda1 == full.lambda1 > 0
+    np.testing.assert_array_equal(first.section["X"], second.section["X"])
+    assert second.motion == "chaotic"
+
+
 def test_orbit_slice_equals_one_sweep_and_stops_when_superseded():
     p = ns.preset("table3")
     values = np.linspace(0.85, 0.95, 12)
     parts = list(compute.orbit_slice(p, "exact", "omega", values, [0.0, 0.0], chunk=5,
                                      transient=100, record=20))
+    with pytest.raises(ns.ParameterError, match="orbit diagram"):
+        next(compute.orbit_slice(ns.model("stick_slip").params(), "exact", "v_belt",
+                                 values, [0.0, 0.0]))
     assert [len(v) for v, _, _ in parts] == [5, 5, 2]
     whole = ns.bifurcation_diagram(p, "omega", values, sweep="up", transient=100, record=20,
                                    method="exact", lyapunov=False)
@@ -86,6 +112,15 @@ def test_orbit_slice_equals_one_sweep_and_stops_when_superseded():
     assert same.sum() >= 6
     np.testing.assert_allclose(np.sort(got[same], axis=1),
                                np.sort(whole.X.isel(sweep=0).values[same], axis=1), atol=1e-6)
+    # several degrees of freedom: every component carried from chunk to chunk, as one sweep
+    q = ns.model("impact_2dof").preset("period_one")
+    om = q.omega * np.linspace(0.97, 1.03, 6)
+    u0 = [0.1, 0.0, 0.3, 0.0]
+    chunks = np.concatenate([pts for _, pts, _ in compute.orbit_slice(
+        q, "exact", "omega", om, u0, chunk=2, transient=60, record=5)])
+    one = ns.bifurcation_diagram(q, "omega", om, sweep="up", transient=60, record=5,
+                                 method="exact", lyapunov=False, u0=u0)
+    np.testing.assert_allclose(chunks, one.X.isel(sweep=0).values, rtol=0, atol=1e-9)
     calls = []
     gen = compute.orbit_slice(p, "exact", "omega", values, [0.0, 0.0], chunk=5, transient=50,
                               record=10, alive=lambda: not calls)
@@ -330,7 +365,7 @@ def test_a_click_in_the_phase_plane_sets_the_initial_condition(page):
     from selenium.webdriver.common.action_chains import ActionChains
 
     fig = page.element("phase_portrait")
-    ActionChains(page.d).move_to_element_with_offset(fig, 0, 0).click().perform()
+    ActionChains(page.d).move_to_element_with_offset(fig, 40, -30).click().perform()
     x0 = wait_for(lambda: float(page.prop("u0_X", "value")) != 0.0 and
                   float(page.prop("u0_X", "value")), "the clicked initial condition")
     assert math.isfinite(x0) and math.isfinite(float(page.prop("u0_V", "value")))
@@ -365,6 +400,20 @@ def test_a_model_that_fails_to_load_is_one_line_and_the_page_keeps_working(page)
              "the impact model's fields")
     assert page.prop("message", "text") == ""
     wait_for(page.settled, "the impact orbit")
+    # four state components: the slice carries all of them, the page shows X and V
+    page.type_into("model", "impact_2dof")
+    wait_for(lambda: page.js("return Bokeh.documents[0].get_model_by_name('u0_W') !== null"),
+             "the 2-DOF model's fields")
+    wait_for(lambda: "(complete)" in (page.prop("slice_status", "text") or ""),
+             "the 2-DOF slice")
+    assert wait_for(page.settled, "the 2-DOF orbit").startswith("period")
+    # no forcing: the time response, and one line saying why there is no orbit diagram
+    page.type_into("model", "stick_slip")
+    wait_for(lambda: page.js("return Bokeh.documents[0].get_model_by_name('param_v_belt') "
+                             "!== null"), "the friction model's fields")
+    assert "no stroboscopic section" in wait_for(page.settled, "the self-excited orbit")
+    assert page.prop("slice_status", "text").startswith("⚠ no orbit diagram: without forcing")
+    assert len(page.data("time_source", "t")) > 100
 
 
 @needs_browser

@@ -158,6 +158,52 @@ for what, kw in bad_models.items():
         print(f"{what}: {err}")
 
 # %%
+# A model written by hand is checked the same way when it is first compiled: here the
+# Jacobian of a hand-written impact oscillator has a wrong sign, and the sample check (the
+# Jacobian against finite differences of the field, in every mode) names the entry.
+from nonsmooth.models import Method, Model, Param, param_index
+
+PARAMS = (Param("omega", 1.2, low=0.0, low_open=True), Param("F0", 0.5))
+F = param_index(PARAMS)["F0"]
+
+
+def field(mode, t, c, s, u, p, mem, du):
+    du[0] = u[1]
+    du[1] = -u[0] - 0.1 * u[1] + p[F] * c
+    return 0
+
+
+def jacobian(mode, t, c, s, u, p, mem, J):
+    J[0, 0] = 0.0
+    J[0, 1] = 1.0
+    J[1, 0] = +1.0          # wrong: d(dV/dt)/dX = -1
+    J[1, 1] = -0.1
+    return 0
+
+
+def guards(mode, p, mem, G):
+    G[0, 0], G[0, 1], G[0, 2], G[0, 3], G[0, 4] = -1.0, 0.0, 1.0, 0.0, 0.0   # 1 - X >= 0
+    return 1
+
+
+def transition(mode, k, t, c, s, u, p, mem):
+    u[1] = -0.8 * u[1]      # the impact: V -> -r V
+    return 0
+
+
+def initial(c, s, u, p, mem):
+    return 0
+
+
+bad = Model(name="bad_jacobian", description="an impact oscillator with a wrong Jacobian",
+            parameters=PARAMS, state_names=("X", "V"), mode_names=("free",),
+            methods={"exact": Method(field, jacobian, guards, transition, initial, modes=(0,))})
+try:
+    ns.simulate(bad.params(), periods=2, method="exact")
+except ns.ParameterError as err:
+    print("refused:", err)
+
+# %%
 # The same model from the command line: save the ``model_from_equations`` call in a file that
 # assigns it to ``MODEL`` and run, for example,
 # ``nonsmooth poincare --model impact_eq.py:MODEL --method exact --record 500 --plot p.png``.

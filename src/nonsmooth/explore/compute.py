@@ -28,6 +28,10 @@ SLICE_CHUNK = 20
 AUTONOMOUS_TIME = 40
 
 
+#: Why a model without forcing (or with its amplitude at 0) has no orbit diagram.
+NO_SECTION = ("no orbit diagram: without forcing there is no stroboscopic section "
+              "(nonsmooth surface-bifurcation draws one on a section surface)")
+
 MOTION_TEXT = {1: "periodic", 2: "quasi-periodic", 3: "chaotic", 4: "not settled"}
 
 
@@ -45,6 +49,7 @@ class Orbit:
     motion: str = ""
     status: str = "ok"
     seconds: float = 0.0
+    lambda1_pending: bool = False   # drawn before its lambda1 (the second stage) is known
 
     def summary(self) -> str:
         """One line for the page: period, lambda1 and the verdict."""
@@ -53,6 +58,8 @@ class Orbit:
         if self.period is None:
             return f"no stroboscopic section ({self.motion or 'no forcing'})"
         per = {0: "no period", -1: "not settled"}.get(self.period, f"period {self.period}")
+        if self.lambda1_pending:
+            return f"{per}, λ1: computing ..."
         lam = ("" if not math.isfinite(self.lambda1) else
                f", λ1 = {self.lambda1:.4g} ± {self.lambda1_stderr:.2g}")
         return f"{per}{lam}{', ' + self.motion if self.motion else ''}"
@@ -67,12 +74,13 @@ def _failed(names, exc) -> Orbit:
 
 def current_orbit(params, method: str, u0, *, transient: int = VIEW_TRANSIENT,
                   record: int = VIEW_RECORD, periods: int = VIEW_PERIODS,
-                  samples: int = VIEW_SAMPLES) -> Orbit:
+                  samples: int = VIEW_SAMPLES, lyapunov: bool = True) -> Orbit:
     """The orbit from ``u0`` after ``transient`` periods: ``periods`` periods drawn at
     ``samples`` per period with their modes, ``record`` section points, the period found on the
-    section and lambda1 with its standard error (``ns.poincare``). A model without forcing (or
-    with its forcing amplitude at 0) has no stroboscopic section: its time response only
-    (``ns.simulate``). A failure is an Orbit with ``status`` saying why (never raised)."""
+    section and (``lyapunov``) lambda1 with its standard error and the verdict
+    (``ns.poincare``). A model without forcing (or with its forcing amplitude at 0) has no
+    stroboscopic section: its time response only (``ns.simulate``). A failure is an Orbit with
+    ``status`` saying why (never raised)."""
     from ..analysis.poincare import poincare
     from ..simulate import simulate
 
@@ -82,9 +90,10 @@ def current_orbit(params, method: str, u0, *, transient: int = VIEW_TRANSIENT,
     var = dict(zip(names, component_names(names)))   # results name u[0], u[1] X and V
     t0 = time.perf_counter()
     try:
-        if _has_section(params):
+        if has_section(params):
             ds = poincare(params, record=record, transient=transient, method=method,
-                          u0=list(u0), orbit_periods=periods, orbit_samples=samples)
+                          u0=list(u0), orbit_periods=periods, orbit_samples=samples,
+                          lyapunov=lyapunov)
             orb = Orbit(t=ds["orbit_t"].values,
                         u={n: ds[f"orbit_{var[n]}"].values for n in names},
                         mode=ds["orbit_region"].values.astype(np.int8),
@@ -93,7 +102,8 @@ def current_orbit(params, method: str, u0, *, transient: int = VIEW_TRANSIENT,
                         lambda1=float(ds["lambda1"]) if "lambda1" in ds else math.nan,
                         lambda1_stderr=(float(ds["lambda1_stderr"]) if "lambda1_stderr" in ds
                                         else math.nan),
-                        motion=MOTION_TEXT.get(int(ds["motion"]), "") if "motion" in ds else "")
+                        motion=MOTION_TEXT.get(int(ds["motion"]), "") if "motion" in ds else "",
+                        lambda1_pending=not lyapunov)
         else:
             n_per = periods if params.model.omega or params.model.period else AUTONOMOUS_TIME
             ds = simulate(params, periods=n_per, transient=transient, method=method,
@@ -108,7 +118,19 @@ def current_orbit(params, method: str, u0, *, transient: int = VIEW_TRANSIENT,
     return orb
 
 
-def _has_section(params) -> bool:
+def orbit_stages(params, method: str, u0, **kw):
+    """The current orbit in two stages: drawn first without lambda1 (the fast part), then
+    with it (Benettin's run over the record for a non-periodic orbit, the dear part). A
+    superseded request stops between the stages (``LatestWorker``)."""
+    first = current_orbit(params, method, u0, lyapunov=False, **kw)
+    yield first
+    if first.status == "ok" and first.period is not None:
+        yield current_orbit(params, method, u0, lyapunov=True, **kw)
+
+
+def has_section(params) -> bool:
+    """Does the model have a stroboscopic section at these parameters (a forcing whose
+    amplitude is not 0)?"""
     m = params.model
     if m.autonomous:
         return False
@@ -120,54 +142,44 @@ class Cancelled(Exception):
     """Raised inside a slice whose request was superseded."""
 
 
-@dataclass
-class Generation:
-    """A counter of requests: work started for generation g stops once a newer one exists."""
-
-    value: int = 0
-    lock: threading.Lock = field(default_factory=threading.Lock)
-
-    def next(self) -> int:
-        with self.lock:
-            self.value += 1
-            return self.value
-
-    def current(self, g: int) -> bool:
-        return g == self.value
-
-
 def orbit_slice(params, method: str, param: str, values, u0, *, transient: int = SLICE_TRANSIENT,
                 record: int = SLICE_RECORD, chunk: int = SLICE_CHUNK, alive=lambda: True,
-                component: str | None = None):
+                component: int = 0):
     """An orbit-diagram slice over ``param`` = ``values`` (increasing), swept up from ``u0``
-    as ``bifurcation_diagram`` sweeps (each value starts from the previous value's state), in
-    chunks of ``chunk`` values: yields (values, section points of ``component``, period) per
-    chunk, and stops (raises Cancelled) between chunks once ``alive()`` is false. Failed
-    values carry NaN points (the sweep goes on from the last good state)."""
-    from ..analysis.bifurcation import bifurcation_diagram
-    from ..io import component_names
+    as ``bifurcation_diagram`` sweeps it (each value starts from the previous value's state,
+    every component of it), in chunks of ``chunk`` values: yields (values, section points of
+    u[``component``] (0 or 1), period) per chunk, and stops (raises Cancelled) between chunks
+    once ``alive()`` is false. Failed values carry NaN points; the sweep goes on from the last
+    good state. A model without forcing (or with its amplitude at 0) has no stroboscopic
+    section: one ParameterError."""
+    from ..analysis.bifurcation import check_values, run_branches
+    from ..integrate.contract import ST_EXTRA
+    from ..kernels import Solver
 
+    if not has_section(params):
+        raise ParameterError(NO_SECTION)
     values = np.asarray(values, dtype=float)
     if values.size == 0:
         raise ParameterError("slice: empty range of values")
-    names = tuple(params.model.state_names)
-    var = dict(zip(names, component_names(names)))   # results name u[0], u[1] X and V
-    comp = var[component or names[0]]
+    if component not in (0, 1):
+        raise ParameterError(f"component: the section holds u[0] and u[1], got u[{component}]")
+    n = len(params.model.state_names)
+    solver = Solver(model=params.model, method=method)
     state = [float(x) for x in u0]
     for i in range(0, values.size, chunk):
         if not alive():
             raise Cancelled()
-        part = values[i:i + chunk]
-        ds = bifurcation_diagram(params, param, part, sweep="up", transient=transient,
-                                 record=record, method=method, u0=state, lyapunov=False,
-                                 workers=1)
-        pts = ds[comp].isel(sweep=0).values
-        last = {n: ds[var[n]].isel(sweep=0).values if var[n] in ds else None for n in names}
-        good = np.flatnonzero(np.isfinite(pts).all(axis=1))
-        if good.size and all(v is not None for v in last.values()):
-            j = int(good[-1])
-            state = [float(last[n][j, -1]) for n in names]
-        yield part, pts, ds["period"].isel(sweep=0).values
+        part = check_values(param, values[i:i + chunk])
+        out = run_branches(params, param, part, solver, directions=["up"],
+                           transient=transient, record=record, x0=state[0], v0=state[1],
+                           extra=state[2:], settle=True, workers=1)
+        pts = np.where((out["status"][0] == 0)[:, None], out["X" if component == 0 else "V"][0],
+                       np.nan)
+        end = out["state"][0]
+        last = [float(end[0]), float(end[1]), *map(float, end[ST_EXTRA:ST_EXTRA + n - 2])]
+        if out["status"][0][-1] == 0 and all(map(math.isfinite, last)):
+            state = last
+        yield part, pts, out["period"][0]
 
 
 #: One computation at a time: numba's parallel regions must not be entered from two threads.
@@ -183,8 +195,11 @@ class LatestWorker:
     values; each is passed to ``deliver(value)`` while its request is still the newest.
     """
 
-    def __init__(self, fn, deliver, name: str = "nonsmooth-explore"):
+    def __init__(self, fn, deliver, name: str = "nonsmooth-explore", defer_to=None):
         self._fn, self._deliver = fn, deliver
+        self._defer_to = defer_to           # a worker whose requests go first (the view)
+        self.idle = threading.Event()
+        self.idle.set()
         self._cond = threading.Condition()
         self._gen = 0
         self._pending = None
@@ -197,8 +212,15 @@ class LatestWorker:
         with self._cond:
             self._gen += 1
             self._pending = (self._gen, args)
+            self.idle.clear()
             self._cond.notify()
             return self._gen
+
+    def cancel(self) -> None:
+        """Abandon the request waiting or running (a refused request supersedes it)."""
+        with self._cond:
+            self._gen += 1
+            self._pending = None
 
     def alive(self, gen: int) -> bool:
         """Is request ``gen`` still the newest?"""
@@ -207,12 +229,14 @@ class LatestWorker:
     def stop(self) -> None:
         with self._cond:
             self._stopped = True
+            self.idle.set()
             self._cond.notify()
 
     def _run(self) -> None:
         while True:
             with self._cond:
                 while self._pending is None and not self._stopped:
+                    self.idle.set()
                     self._cond.wait()
                 if self._stopped:
                     return
@@ -223,6 +247,8 @@ class LatestWorker:
                 out = self._fn(*args, alive=alive)
                 if hasattr(out, "__next__"):
                     while True:
+                        if self._defer_to is not None:   # let the view go first
+                            self._defer_to.idle.wait()
                         with COMPUTE_LOCK:
                             if not alive():
                                 break

@@ -6,8 +6,10 @@ background threads (``compute.LatestWorker``): a newer request supersedes an old
 
 from __future__ import annotations
 
+import html
 import math
 import shlex
+import threading
 from functools import partial
 
 import numpy as np
@@ -26,7 +28,8 @@ MODE_COLORS = ("#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564b",
 
 def slider_range(prm, value: float) -> tuple[float, float]:
     """A slider's (start, end) for parameter ``prm`` around ``value``: the parameter's own
-    bounds where finite, else a range around the value (a decade for a positive parameter)."""
+    bounds where finite (an open end moved in by one slider step, so that both ends are
+    allowed), else a range around the value (up to twice a positive one)."""
     lo = prm.low if math.isfinite(prm.low) else None
     hi = prm.high if math.isfinite(prm.high) else None
     span = max(abs(value), 1.0)
@@ -36,7 +39,41 @@ def slider_range(prm, value: float) -> tuple[float, float]:
         hi = max(2.0 * value, lo + span) if value > 0 else value + span
     if hi - lo > 20 * span and value > 0 and lo >= 0:      # e.g. 0 < omega_s < inf
         hi = max(4.0 * value, lo + span)
+    step = (hi - lo) / SLIDER_STEPS
+    if prm.low_open and lo == prm.low:
+        lo += step
+    if prm.high_open and hi == prm.high:
+        hi -= step
     return float(lo), float(hi)
+
+
+def slice_range(model, values: dict, name: str) -> tuple[float, float]:
+    """The default range of the orbit-diagram slice over ``name``: +-20 % around its value
+    (the slider's range for a value of 0), narrowed until both ends pass the model's checks
+    (its parameter ranges and cross-field rules)."""
+    prm = model.param(name)
+    v = values[name]
+    lo, hi = (0.8 * v, 1.2 * v) if v > 0 else (1.2 * v, 0.8 * v) if v < 0 else \
+        slider_range(prm, v)
+    for _ in range(30):
+        if _allowed(model, values, name, lo) and _allowed(model, values, name, hi):
+            return lo, hi
+        lo, hi = v + 0.5 * (lo - v), v + 0.5 * (hi - v)
+    return v, v
+
+
+def _allowed(model, values: dict, name: str, x: float) -> bool:
+    try:
+        model.validate({**values, name: x})
+    except ParameterError:
+        return False
+    return True
+
+
+def _one_line(exc) -> str:
+    """An exception's first line, escaped for a Div's HTML."""
+    text = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+    return html.escape(text)
 
 
 def _fmt(v: float) -> str:
@@ -56,12 +93,14 @@ class Explorer:
         self.method = method
         self.u0: list[float] = []
         self.pair = (0, 1)
+        self._drawn_gen = 0
         self._show_names = show
         self.message = Div(text="", name="message", styles={"color": "#b00020"})
         self._view_worker = compute.LatestWorker(self._compute_view, self._deliver(self._show_view),
                                                  "explore-view")
         self._slice_worker = compute.LatestWorker(self._compute_slice,
-                                                  self._deliver(self._show_slice), "explore-slice")
+                                                  self._deliver(self._show_slice), "explore-slice",
+                                                  defer_to=self._view_worker)
         self._build_static()
         self.load_model(model, method=method, preset=preset, sets=sets, slice_param=slice_param)
         doc.add_root(self.layout)
@@ -82,14 +121,11 @@ class Explorer:
         return self.model.params(**self.values)
 
     def _compute_view(self, params, method, u0, alive):
-        with compute.COMPUTE_LOCK:
-            if not alive():
-                raise compute.Cancelled()
-            return compute.current_orbit(params, method, u0)
+        return compute.orbit_stages(params, method, u0)
 
-    def _compute_slice(self, params, method, param, values, u0, alive):
+    def _compute_slice(self, params, method, param, values, u0, component, alive):
         return compute.orbit_slice(params, method, param, values, u0, alive=alive,
-                                   component=self.model.state_names[self.pair[0]])
+                                   component=component)
 
     # ---- layout -------------------------------------------------------------------------------
     def _build_static(self):
@@ -109,7 +145,7 @@ class Explorer:
         self.modes = Div(text="", name="modes", width=520)
         self.slice_status = Div(text="", name="slice_status", width=520)
 
-        tools = "pan,wheel_zoom,box_zoom,reset,tap"
+        tools = "pan,wheel_zoom,box_zoom,reset"    # clicks arrive as Tap events
         self.time_src = ColumnDataSource(dict(t=[], a=[], color=[]), name="time_source")
         self.orbit_src = ColumnDataSource(dict(a=[], b=[], color=[]), name="orbit_source")
         self.section_src = ColumnDataSource(dict(a=[], b=[]), name="section_source")
@@ -160,13 +196,14 @@ class Explorer:
         self.layout = row(controls, panels)
 
     # ---- the model and its widgets ------------------------------------------------------------
-    def load_model(self, name, method=None, preset=None, sets=None, slice_param=None) -> bool:
-        """Show ``name``'s parameters; on failure the page says why in one line and keeps the
-        model it had."""
+    def load_model(self, name, method=None, preset=None, sets=None, slice_param=None,
+                   loaded=None) -> bool:
+        """Show ``name``'s parameters (``loaded``: the model, already loaded); on failure the
+        page says why in one line and keeps the model it had."""
         from ..models import model as get_model
 
         try:
-            m = get_model(name)
+            m = loaded if loaded is not None else get_model(name)
             params = m.preset(preset) if preset else m.params()
             if sets:
                 params = params.replace(**sets)
@@ -174,20 +211,20 @@ class Explorer:
                 raise ParameterError(f"method: {method!r} is not a method of {m.name} "
                                      f"({', '.join(m.methods)})")
         except (NonsmoothError, TypeError, ValueError) as exc:
-            self.message.text = f"model {name}: {str(exc).splitlines()[0]}"
+            self.message.text = f"model {html.escape(str(name))}: {_one_line(exc)}"
             self.model_input.value = self.model_name if self.model is not None else str(name)
             return False
+        names = m.state_names
+        pair = (0, 1)
+        if self._show_names and all(x in names for x in self._show_names):
+            pair = tuple(names.index(x) for x in self._show_names)
         self.message.text = ""
-        self.model, self.model_name = m, str(name)
+        self._view_worker.cancel()
+        self._slice_worker.cancel()
+        self.model, self.model_name, self.pair = m, str(name), pair
         self.values = dict(params.as_dict())
         self.method = method or ("smooth" if "smooth" in m.methods else next(iter(m.methods)))
         self.u0 = [0.0] * len(m.state_names)
-        names = m.state_names
-        if self._show_names:
-            a, b = self._show_names
-            self.pair = (names.index(a), names.index(b))
-        else:
-            self.pair = (0, 1)
         self.model_input.value = str(name)
         self.modes.text = "modes: " + " ".join(
             f"<span style='color:{MODE_COLORS[k % len(MODE_COLORS)]}'>&#9632;</span> {nm}"
@@ -199,7 +236,6 @@ class Explorer:
         self.time_fig.yaxis.axis_label = names[self.pair[0]]
         self.phase_fig.xaxis.axis_label = names[self.pair[0]]
         self.phase_fig.yaxis.axis_label = names[self.pair[1]]
-        self.slice_fig.yaxis.axis_label = f"{names[self.pair[0]]} on the section"
         opts = list(m.param_names)
         default = slice_param or m.forcing_param or opts[0]
         self.slice_param.options = opts
@@ -239,9 +275,30 @@ class Explorer:
 
     # ---- events -------------------------------------------------------------------------------
     def _on_model(self, name):
-        if self.model is not None and name == self.model_name:
+        name = name.strip()
+        if not name or (self.model is not None and name == self.model_name):
             return
-        self.load_model(name.strip())
+        # loading a user model compiles it (seconds, minutes on an empty cache): in a thread,
+        # so that the page (and every other session) stays responsive
+        self.message.text = f"loading model {html.escape(name)} ..."
+        self.message.styles = {"color": "#555555"}
+
+        def load():
+            from ..models import model as get_model
+            try:
+                m, err = get_model(name), None
+            except (NonsmoothError, TypeError, ValueError) as exc:
+                m, err = None, exc
+            self.doc.add_next_tick_callback(partial(self._loaded, name, m, err))
+        threading.Thread(target=load, name="explore-load-model", daemon=True).start()
+
+    def _loaded(self, name, m, err):
+        self.message.styles = {"color": "#b00020"}
+        if err is not None:
+            self.message.text = f"model {html.escape(name)}: {_one_line(err)}"
+            self.model_input.value = self.model_name
+            return
+        self.load_model(name, loaded=m)
 
     def _on_method(self, name):
         if name and name != self.method:
@@ -258,7 +315,7 @@ class Explorer:
             v = prm.check(new.strip())
             self.model.validate({**self.values, prm.name: v})
         except ParameterError as exc:
-            field.title = f"⚠ {str(exc).splitlines()[0]}"
+            field.title = f"⚠ {str(exc).splitlines()[0]}"     # a title is text, not HTML
             return
         field.title = self._label(prm)
         self.set_param(prm.name, v, from_field=True)
@@ -284,8 +341,11 @@ class Explorer:
 
     def _on_phase_tap(self, event):
         a, b = self.pair
-        self.u0_fields[a].value = _fmt(float(event.x))
-        self.u0_fields[b].value = _fmt(float(event.y))
+        self.u0[a], self.u0[b] = float(event.x), float(event.y)
+        self.u0_fields[a].value = _fmt(self.u0[a])     # equal to u0 now: no second request
+        self.u0_fields[b].value = _fmt(self.u0[b])
+        self.request_view()
+        self.request_slice()
 
     def _on_slice_tap(self, event):
         name = self.slice_param.value
@@ -296,11 +356,8 @@ class Explorer:
             self._set_slice_param(name)
 
     def _set_slice_param(self, name):
-        prm = self.model.param(name)
         v = self.values[name]
-        lo, hi = slider_range(prm, v)
-        if self.model.forcing_param == name and v > 0:
-            lo, hi = 0.8 * v, 1.2 * v
+        lo, hi = slice_range(self.model, self.values, name)
         self.slice_param.value = name
         self.slice_lo.value, self.slice_hi.value = _fmt(lo), _fmt(hi)
         self.slice_fig.xaxis.axis_label = name
@@ -331,7 +388,8 @@ class Explorer:
         try:
             params = self._params()
         except ParameterError as exc:
-            self.status.text = f"⚠ {exc}"
+            self._view_worker.cancel()
+            self.status.text = f"⚠ {_one_line(exc)}"
             return
         self.status.text = "computing ..."
         self._view_worker.submit(params, self.method, list(self.u0))
@@ -342,30 +400,48 @@ class Explorer:
             return
         name = self.slice_param.value
         prm = self.model.param(name)
+        self.slice_src.data = dict(value=[], point=[])
         try:
+            params = self._params()
+            if not compute.has_section(params):
+                raise ParameterError(compute.NO_SECTION)
             lo, hi = prm.check(self.slice_lo.value), prm.check(self.slice_hi.value)
-            n = int(self.slice_n.value)
+            for end in (lo, hi):
+                self.model.validate({**self.values, name: end})
+            try:
+                n = int(self.slice_n.value)
+            except ValueError:
+                raise ParameterError(f"values: expected a whole number, got "
+                                     f"{self.slice_n.value!r}") from None
             if not 2 <= n <= 5000:
                 raise ParameterError(f"values: between 2 and 5000, got {n}")
             if not hi > lo:
                 raise ParameterError(f"slice: 'to' must be above 'from' ({lo:g} .. {hi:g})")
-            params = self._params()
-        except (ParameterError, ValueError) as exc:
-            self.slice_status.text = f"⚠ {str(exc).splitlines()[0]}"
+        except ParameterError as exc:
+            self._slice_worker.cancel()
+            self.slice_status.text = f"⚠ {_one_line(exc)}"
             return
-        self.slice_src.data = dict(value=[], point=[])
         self._slice_total = n
         self._slice_done = 0
         self.slice_status.text = f"orbit diagram: 0 of {n} values"
+        component = self.pair[0] if self.pair[0] in (0, 1) else 0
+        self.slice_fig.yaxis.axis_label = f"{self.model.state_names[component]} on the section"
         self._slice_gen = self._slice_worker.submit(params, self.method, name,
-                                                    np.linspace(lo, hi, n), list(self.u0))
+                                                    np.linspace(lo, hi, n), list(self.u0),
+                                                    component)
 
     def _show_view(self, gen, orbit):
         if not self._view_worker.alive(gen):
             return
         if isinstance(orbit, Exception):
-            self.status.text = f"failed: {str(orbit).splitlines()[0] if str(orbit) else orbit!r}"
+            self.status.text = f"failed: {_one_line(orbit)}"
             return
+        summary = (f"{html.escape(orbit.summary())} <span style='color:#888'>"
+                   f"({1000 * orbit.seconds:.0f} ms)</span>")
+        if gen == self._drawn_gen:      # the second stage: the same orbit with its lambda1
+            self.status.text = summary
+            return
+        self._drawn_gen = gen
         names = self.model.state_names
         a, b = (names[i] for i in self.pair)
         colors = [MODE_COLORS[int(m) % len(MODE_COLORS)] for m in orbit.mode]
@@ -373,8 +449,7 @@ class Explorer:
         self.orbit_src.data = dict(a=orbit.u.get(a, []), b=orbit.u.get(b, []), color=colors)
         self.section_src.data = dict(a=orbit.section.get(a, []), b=orbit.section.get(b, []))
         self._draw_levels()
-        self.status.text = (f"{orbit.summary()} <span style='color:#888'>"
-                            f"({1000 * orbit.seconds:.0f} ms)</span>")
+        self.status.text = summary
 
     def _draw_levels(self):
         from bokeh.models import Span
@@ -401,7 +476,7 @@ class Explorer:
         if not self._slice_worker.alive(gen):
             return
         if isinstance(part, Exception):
-            self.slice_status.text = f"orbit diagram failed: {str(part).splitlines()[0]}"
+            self.slice_status.text = f"orbit diagram failed: {_one_line(part)}"
             return
         values, pts, _period = part
         vv = np.repeat(values, pts.shape[1])
@@ -416,26 +491,37 @@ class Explorer:
     # ---- export -------------------------------------------------------------------------------
     def export(self):
         """The current parameters as a ``nonsmooth`` command line and a Python snippet."""
+        names = self.model.state_names
+        show = None if self.pair == (0, 1) else tuple(names[i] for i in self.pair)
         self.export_text.value = export_text(self.model_name, self.model, self.values,
-                                             self.method, self.u0)
+                                             self.method, self.u0, show=show)
 
 
-def export_text(model_name: str, model, values: dict, method: str, u0) -> str:
-    """A command line (``nonsmooth poincare ...``) and a Python snippet for these settings."""
+def export_text(model_name: str, model, values: dict, method: str, u0, show=None) -> str:
+    """A command line and a Python snippet that compute what the page shows: ``poincare``
+    with the page's transient and record (a model without a section: ``simulate`` over the
+    periods drawn, after the same transient), from the same state, showing the same pair of
+    components (``show``)."""
     sets = " ".join(f"--set {k}={_fmt(v)}" for k, v in values.items())
     names = model.state_names
     u0_arg = ",".join(f"{n}={_fmt(x)}" for n, x in zip(names, u0))
-    forced = not model.autonomous and (model.forcing_amplitude is None
-                                       or values.get(model.forcing_amplitude, 1.0) != 0.0)
-    cmd = "poincare --record 200 --transient 200" if forced else "simulate --periods 20"
+    forced = compute.has_section(model.params(**values))
+    tr, rec = compute.VIEW_TRANSIENT, compute.VIEW_RECORD
+    periods = compute.VIEW_PERIODS if model.omega or model.period else compute.AUTONOMOUS_TIME
+    cmd = (f"poincare --record {rec} --transient {tr}" if forced else
+           f"simulate --periods {periods} --transient {tr}")
+    show_arg = f" --show {','.join(show)}" if show else ""
     line = (f"nonsmooth {cmd} --model {shlex.quote(model_name)} --method {method} {sets} "
-            f"--u0 {u0_arg} -o explore.nc --plot explore.png")
+            f"--u0 {u0_arg}{show_arg} -o explore.nc --plot explore.png")
     kw = ", ".join(f"{k}={_fmt(v)}" for k, v in values.items())
-    call = ("ns.poincare(p, record=200, transient=200" if forced else
-            "ns.simulate(p, periods=20")
+    call = (f"ns.poincare(p, record={rec}, transient={tr}" if forced else
+            f"ns.simulate(p, periods={periods}, transient={tr}")
+    figure = "plot_poincare" if forced else "plot_time_response"
+    show_kw = f", show={tuple(show)!r}" if show else ""
     py = (f"import nonsmooth as ns\n\n"
           f"p = ns.model({model_name!r}).params({kw})\n"
-          f"ds = {call}, method={method!r}, u0={[float(x) for x in u0]!r})\n")
+          f"ds = {call}, method={method!r}, u0={[float(x) for x in u0]!r})\n"
+          f"fig = ns.plot.{figure}(ds{show_kw})\n")
     return f"{line}\n\n{py}"
 
 

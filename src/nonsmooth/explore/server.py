@@ -18,6 +18,7 @@ def free_port(host: str = "127.0.0.1") -> int:
 def check_port(host: str, port: int) -> None:
     """A one-line OutputError if ``host:port`` cannot be listened on (in use, not allowed)."""
     with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as s:
+        s.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)   # as tornado binds
         try:
             s.bind((host, port))
         except OSError as exc:
