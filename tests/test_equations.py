@@ -307,3 +307,28 @@ def test_a_self_excited_cycle_is_the_same_with_a_period_parameter():
     assert float(a.period) == pytest.approx(float(b.period), rel=1e-9)
     assert float(a.max_X) == pytest.approx(float(b.max_X), abs=1e-8)
     assert float(a.max_X) == pytest.approx(2.0086, abs=1e-3)  # van der Pol, mu = 1
+
+
+def test_a_resonance_over_a_period_names_its_points_by_the_period():
+    """Swept over a period T, the resonance curve's contact and jump points are T_a, T_b,
+    T_c (the omega_* names stay, with the same values); the figure labels them so."""
+    from nonsmooth.analysis.resonance import jump_names
+
+    m = ns.model_from_equations(
+        "impact_period", states=("X", "V"),
+        parameters={"xi": 0.05, "F0": 0.5, "r": dict(default=0.8, low=0.0, high=1.0),
+                    "T": dict(default=5.0, low=0.0, low_open=True)},
+        modes={"free": ["V", "-X - xi*V + F0*cos(2*pi*t/T)"]},
+        guards={"free": [ns.Guard("1 - X", "free", reset={"V": "-r*V"})]}, method="exact",
+        period="T", forcing_amplitude="F0", contact_level=lambda p: 1.0)
+    res = ns.resonance_curve(m.params(), np.linspace(4.0, 9.0, 26), method="exact",
+                             transient=100, record=10)
+    assert jump_names(res) == ("T_a", "T_b", "T_c")
+    assert 4.0 < res.attrs["T_a"] == res.attrs["omega_a"] < 9.0
+    np.testing.assert_array_equal(res.attrs["T_c_bracket"], res.attrs["omega_c_bracket"])
+    fig = ns.plot.plot_resonance(res)
+    texts = [t.get_text() for t in fig.axes[0].texts]
+    assert any(t.startswith("$T_a = ") for t in texts) and not any("omega" in t for t in texts)
+    assert jump_names(ns.resonance_curve(ns.preset("fig6a"), np.linspace(0.9, 1.0, 3),
+                                         transient=20, record=5)) == \
+        ("omega_a", "omega_b", "omega_c")

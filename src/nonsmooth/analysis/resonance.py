@@ -236,7 +236,18 @@ def resonance_curve(params: ParamsBase, omegas, *, method: str = "smooth", trans
                           **freqs)
     if branches == "all":
         _all_branches(ds, params, w_name, omegas, out, method, section_phase)
+    if w_name != "omega":  # the same points named by the swept parameter (a period T: T_a ...)
+        ds.attrs.update({k.replace("omega", w_name, 1): v for k, v in list(ds.attrs.items())
+                         if k.startswith(("omega_a", "omega_b", "omega_c"))})
     return ds
+
+
+def jump_names(ds) -> tuple:
+    """The names of the jump points of a resonance Dataset: ("omega_a", "omega_b",
+    "omega_c"), or those of the swept parameter where it is not omega ("T_a", ...)."""
+    w = str(ds.attrs.get("swept_param", "omega"))
+    w = w if f"{w}_a" in ds.attrs else "omega"
+    return tuple(f"{w}_{k}" for k in "abc")
 
 
 def _all_branches(ds, params, w_name, omegas, out, method, section_phase=0.0):

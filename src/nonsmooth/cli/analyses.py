@@ -250,12 +250,14 @@ def resonance_cmd(
                              store=store, engine=engine)
     from ..plot.resonance import plot_resonance
     save_outputs(ds, preset, out, plot, plot_resonance, store=store)
+    from ..analysis.resonance import jump_names
     a = ds.attrs
-    typer.echo(f"{preset}: omega_a = {a['omega_a']:.5f} (contact starts), "
-               f"omega_b = {a['omega_b']:.5f}, omega_c = {a['omega_c']:.5f} (jumps; NaN = none)")
+    na, nb, nc = jump_names(ds)   # omega_a, ... or, sweeping a period T, T_a, ...
+    typer.echo(f"{preset}: {na} = {a[na]:.5f} (contact starts), "
+               f"{nb} = {a[nb]:.5f}, {nc} = {a[nc]:.5f} (jumps; NaN = none)")
     if all_branches:
         typer.echo(f"continuation ({a['branch_status']}): "
-                   f"omega_a = {a['omega_a_continuation']:.8f} (grazing), "
-                   f"omega_b = {a['omega_b_continuation']:.8f}, "
-                   f"omega_c = {a['omega_c_continuation']:.8f} (folds; NaN = none)")
+                   f"{na} = {a[na + '_continuation']:.8f} (grazing), "
+                   f"{nb} = {a[nb + '_continuation']:.8f}, "
+                   f"{nc} = {a[nc + '_continuation']:.8f} (folds; NaN = none)")
     echo_written(out, plot)

@@ -16,7 +16,8 @@ def plot_resonance(ds, show_min: bool = True):
     model's lines of X (support: X = 1)."""
     fig, ax = new_figure(figsize=(8, 5))
     m = model_of(ds)
-    wname = m.forcing_param if m is not None and m.forcing_param in ds else "omega"
+    wname = (m.forcing_param if m is not None and m.forcing_param in ds else
+             str(ds.attrs.get("swept_param", "omega")))
     w = ds[wname].values
     for j, name in enumerate(sweep_names(ds)):
         style = dict(SWEEP_STYLE.get(str(name), dict(color="0.3", marker=".", label=str(name))))
@@ -37,9 +38,12 @@ def plot_resonance(ds, show_min: bool = True):
                 y = np.where(edge, bm, math.nan)
             ax.plot(bw, y, ls=ls, color="k", lw=1.3, label=lab, zorder=3)
     draw_lines_over(ax, ds, wname, w, style=dict(ls=":"))
-    for key, sym, col in (("omega_a", r"\omega_a", "#2ca02c"), ("omega_b", r"\omega_b", "#9467bd"),
-                          ("omega_c", r"\omega_c", "#8c564b")):
+    from ..analysis.resonance import jump_names
+    for key, col in zip(jump_names(ds), ("#2ca02c", "#9467bd", "#8c564b")):
         v = float(ds.attrs.get(key, math.nan))
+        base, _, k = key.rpartition("_")
+        sym = (r"\omega" if base == "omega" else base if base.isalnum() else
+               r"\mathrm{" + base.replace("_", r"\_") + "}") + f"_{k}"
         if math.isfinite(v):
             ax.axvline(v, color=col, lw=0.9, ls="-.")
             ax.annotate(f"${sym} = {v:.4f}$", xy=(v, 0.03), xycoords=("data", "axes fraction"),
