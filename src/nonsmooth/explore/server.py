@@ -48,7 +48,14 @@ def make_server(host: str = "127.0.0.1", port: int | None = None, **page_kw):
 def serve(host: str = "127.0.0.1", port: int | None = None, open_browser: bool = True,
           log=print, **page_kw) -> None:
     """Serve the explore page until Ctrl-C (then stop cleanly and return)."""
+    import signal
+    import threading
+
     server, url = make_server(host, port, **page_kw)
+    if threading.current_thread() is threading.main_thread():
+        # as servers do: Ctrl-C (SIGINT) stops it even where the shell that started it in
+        # the background set SIGINT to be ignored
+        signal.signal(signal.SIGINT, signal.default_int_handler)
     server.start()
     log(f"nonsmooth explore: {url}  (Ctrl-C stops it)")
     if open_browser:
