@@ -42,8 +42,8 @@ from ..kernels import new_state, output_buffers, run
 from ..models.base import KERNEL_GENERIC
 from ..simulate import component_variables
 from ..tangent import TangentSetup, period_map
-from .continuation import (FOLD, GRAZING, NEIMARK_SACKER, PERIOD_DOUBLING, _accepted, _follow,
-                           bordered_step, branch_arguments)
+from .continuation import (FOLD, GRAZING, LOCATE_TOL, NEIMARK_SACKER, PERIOD_DOUBLING,
+                           _accepted, _follow, bordered_step, branch_arguments)
 from .stability import _active, _section_state
 
 
@@ -199,19 +199,53 @@ def _codim2_tests(mu, kind):
             float(np.prod(np.abs(pairs) ** 2 - 1.0)) if len(pairs) else math.nan)
 
 
-def _codim2(pts, kind, N):
+def _codim2(br, pts, kind, N):
     """(type, l1, l2, index) of each codimension-two point: a test of CODIM2_NAMES changes
-    sign between points i and i + 1; located by linear interpolation of the test."""
+    sign between points i and i + 1; located by the Illinois method on the arclength from
+    point i along its tangent, every trial point corrected onto the curve (as the special
+    points of ``continuation``), to LOCATE_TOL in the arclength; by linear interpolation of
+    the test where a trial point does not converge."""
     out = []
     tests = [_codim2_tests(f["mu"], kind) for _, f in pts]
     for i in range(len(pts) - 1):
         for j in range(3):
             a, b = tests[i][j], tests[i + 1][j]
             if math.isfinite(a) and math.isfinite(b) and a * b < 0.0:
-                s = a / (a - b)
-                y = pts[i][0] + s * (pts[i + 1][0] - pts[i][0])
+                y = _locate_codim2(br, pts[i], pts[i + 1][0], kind, j, a, b)
+                if y is None:
+                    s = a / (a - b)
+                    y = pts[i][0] + s * (pts[i + 1][0] - pts[i][0])
                 out.append((_CODIM2[(kind, j)], float(y[N]), float(y[N - 1]), i))
     return out
+
+
+def _locate_codim2(br, start, y_end, kind, j, a, b):
+    """The point between ``start`` = (y0, features) and ``y_end`` where codimension-two test
+    ``j`` is zero (Illinois on the arclength along the start's tangent), or None."""
+    from ..integrate.roots import illinois_point, illinois_update
+
+    y0, f0 = start
+    t0 = f0["t"]
+    ds = float(t0 @ (y_end - y0))  # the corrector keeps t0 . (y - y0) = the step
+    if not ds > 0.0:
+        return None
+    sg = -1.0 if b > 0 else 1.0  # Illinois in g = f sign: g(0) > 0, g(ds) < 0
+    lo, hi, glo, ghi, side = 0.0, ds, sg * a, sg * b, 0
+    best = None
+    for _ in range(60):
+        s = illinois_point(lo, hi, glo, ghi)
+        got = br.correct(y0 + s * t0, t0, y0)
+        if got is None:
+            return None
+        y, ev, _ = got
+        g = _codim2_tests(br.features(y, ev, t0)["mu"], kind)[j]
+        if not math.isfinite(g):
+            return None
+        best = y
+        lo, hi, glo, ghi, side = illinois_update(lo, hi, glo, ghi, side, s, sg * g)
+        if hi - lo <= LOCATE_TOL or g == 0.0:
+            break
+    return best
 
 
 def _cusps(pts, N):
@@ -384,7 +418,7 @@ def _special_curve(kind, params, param, param2, start, special, direction, step,
     ds = _dataset(params, solver, p1, p2, k, pts, cusps, status, Nz,
                   {FOLD: "fold_curve", PERIOD_DOUBLING: "period_doubling_curve",
                    GRAZING: "grazing_curve", NEIMARK_SACKER: "neimark_sacker_curve"}[kind])
-    c2 = _codim2(pts, kind, Nz + 1) if kind != NEIMARK_SACKER else []
+    c2 = _codim2(br, pts, kind, Nz + 1) if kind != NEIMARK_SACKER else []
     s1, s2 = m.param(p1), m.param(p2)
     ds["codim2_type"] = ("codim2", np.array([c[0] for c in c2], np.int8), {
         "long_name": "codimension-two point on the curve",
