@@ -200,3 +200,34 @@ def test_cli_manifolds_writes_the_api_result_and_a_figure(tmp_path, capsys, fig7
     code, out, err = run_cli(["manifolds", "--spacing", "-1"], capsys)
     assert code == 2
     one_line(err, "spacing")
+
+
+def test_the_manifolds_of_each_point_of_a_period_two_saddle_are_images_of_each_other():
+    """Table 4 at F0 = 0.225: the period-2 orbit left unstable by the doubling to period 4
+    (a flip saddle, mu = -6.41: grown with P^4). The unstable manifold of its point 1 is the
+    image by one forcing period of that of its point 0."""
+    p = ns.preset("table4").replace(F0=0.225)
+    orbit = ns.periodic_orbit(p, k=2, x0=1.013, v0=0.478)
+    assert orbit.attrs["converged"] == 1 and float(orbit.multiplier_real[0]) < -6.0
+    kw = dict(x=(0.0, 1.3), v=(-0.5, 1.5), stable=False)
+    m0 = ns.manifolds(p, orbit, length=0.5, **kw)
+    m1 = ns.manifolds(p, orbit, point=1, length=2.0, **kw)
+    assert m0.attrs["map_periods"] == m1.attrs["map_periods"] == 4
+    assert m1.attrs["orbit_point"] == 1
+    assert abs(float(m1.saddle_X) - float(orbit.X_section[1])) < 1e-9
+    assert abs(float(m1.saddle_V) - float(orbit.V_section[1])) < 1e-9
+    u1 = m1.where(m1.branch <= 1, drop=True)
+    a = np.c_[u1.X.values[:-1], u1.V.values[:-1]]
+    ab = np.c_[np.diff(u1.X.values), np.diff(u1.V.values)]
+    u0 = m0.where(m0.branch <= 1, drop=True)
+    gaps = []
+    for i in np.linspace(0, u0.sizes["point"] - 1, 12).astype(int):
+        d = ns.simulate(p, periods=1, samples_per_period=1, method="exact", x0=float(u0.X[i]),
+                        v0=float(u0.V[i]), rtol=1e-10, atol=1e-12)
+        q = np.array([float(d.X[-1]), float(d.V[-1])])
+        t = np.clip(((q - a) * ab).sum(1) / np.maximum((ab * ab).sum(1), 1e-300), 0.0, 1.0)
+        gaps.append(np.min(np.hypot(*(a + t[:, None] * ab - q).T)))
+    spacing = m1.attrs["spacing"]
+    assert max(gaps) < spacing / 10 and np.median(gaps) < 1e-5  # chords' sagitta; 8e-6
+    with pytest.raises(ParameterError, match="point: a period-2 orbit has section points 0"):
+        ns.manifolds(p, orbit, point=2, **kw)

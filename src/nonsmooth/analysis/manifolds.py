@@ -417,6 +417,33 @@ def _positive(name, value):
     return value
 
 
+def _centred(params, orbit, point):
+    """``orbit`` with its section point ``point`` first: Newton shooting from it (converged
+    there already) gives that point's monodromy."""
+    from ..simulate import check_int
+    from .stability import periodic_orbit
+
+    point = check_int("point", point, 0)
+    if not isinstance(orbit, xr.Dataset) or orbit.attrs.get("analysis") != "periodic_orbit":
+        raise ParameterError("orbit: expected the Dataset of periodic_orbit(...)")
+    k = int(orbit.attrs.get("k", 1))
+    if point >= k:
+        raise ParameterError(f"point: a period-{k} orbit has section points 0 ... {k - 1}, "
+                             f"got {point}")
+    if point == 0:
+        return orbit
+    u = np.asarray(components(orbit, suffix="_section").values[point], dtype=float)
+    again = periodic_orbit(params, k=k, u0=[float(c) for c in u],
+                           method=str(orbit.attrs.get("method", "exact")),
+                           rtol=float(orbit.attrs.get("rtol", 1e-10)),
+                           atol=float(orbit.attrs.get("atol", 1e-12)),
+                           section_phase=float(orbit.attrs.get("section_phase", 0.0)))
+    if int(again.attrs.get("converged", 0)) != 1:
+        raise ParameterError(f"point: the orbit re-centred at its point {point} does not "
+                             f"converge ({again.attrs.get('status')})")
+    return again
+
+
 def _saddle(params, orbit):
     """(solver, setup, k, z*, active mask, mu (active), eigenvectors (active, columns))."""
     from ..kernels import Solver
@@ -459,7 +486,7 @@ def manifolds(params, orbit, *, x=None, v=None, spacing: float | None = None,
               delta: float | None = None, max_angle: float = 0.3, length: float | None = None,
               iterates: int | None = None, max_points: int = 4000, stable: bool = True,
               radius: float | None = None, max_search: int = 100,
-              tol: float | None = None) -> xr.Dataset:
+              tol: float | None = None, point: int = 0) -> xr.Dataset:
     """The stable and unstable manifolds of the saddle ``orbit`` (a converged
     :func:`nonsmooth.periodic_orbit` of ``params``, same model and parameters; its method, k,
     tolerances and section phase are used) as polylines, by the methods of the module
@@ -476,7 +503,9 @@ def manifolds(params, orbit, *, x=None, v=None, spacing: float | None = None,
     the stable manifold (needs a two-dimensional section); ``radius``: the saddle's
     neighbourhood in the classification (default 5 spacings); ``max_search``: iterates of the
     map before a point is called unclassified; ``tol``: the stable points' accuracy across
-    the curve (default spacing / 10^4).
+    the curve (default spacing / 10^4); ``point``: which of a period-k saddle's k section
+    points the manifolds belong to (default 0; the orbit is re-centred there by Newton
+    shooting, its monodromy taken there: the manifolds of point j are those of P^k at z_j).
 
     Returns a Dataset over ``point`` (all branches one after the other): ``X``, ``V`` (and the
     further state components), ``branch`` (flag: unstable_plus, unstable_minus, stable_plus,
@@ -493,6 +522,7 @@ def manifolds(params, orbit, *, x=None, v=None, spacing: float | None = None,
         raise ParameterError(f"manifolds: model {m.name} declares no forcing; the manifolds "
                              f"here are those of the stroboscopic map")
     window = _check_window(x, v)
+    orbit = _centred(params, orbit, point)
     solver, setup, k, p, zs, act, mu, E = _saddle(params, orbit)
     diag = (math.hypot(window[0][1] - window[0][0], window[1][1] - window[1][0])
             if window else None)
@@ -563,7 +593,8 @@ def manifolds(params, orbit, *, x=None, v=None, spacing: float | None = None,
                     statuses, ends, cross, stable_method, dict(
                         spacing=spacing, delta=delta, max_angle=max_angle, length=length,
                         iterates=iterates, max_points=max_points, radius=radius,
-                        max_search=max_search, tol=tol, periods_integrated=mp.periods))
+                        max_search=max_search, tol=tol, periods_integrated=mp.periods,
+                        orbit_point=int(point)))
 
 
 def _dataset(params, solver, k, q, zs, mu, e_u, e_s, branches, levels, statuses, ends, cross,

@@ -23,6 +23,8 @@ def manifolds_cmd(
     preset: PresetOpt = None,
     set_: SetOpt = None,
     k: Annotated[int, typer.Option("--k", help="period of the saddle in forcing periods")] = 1,
+    point: Annotated[int, typer.Option(
+        "--point", help="which of a period-k saddle's k section points (0 ... k-1)")] = 0,
     x0: X0Opt = -1.5,
     v0: V0Opt = 0.25,
     u0: U0Opt = None,
@@ -69,7 +71,8 @@ def manifolds_cmd(
                    f"{v0:g}): {orbit.attrs['status']}; try another start (--x0, --v0, --u0)",
                    err=True)
         raise typer.Exit(EXIT_NOT_FOUND)
-    ds = manifolds(params, orbit, x=x, v=v, spacing=spacing, length=length, stable=stable)
+    ds = manifolds(params, orbit, x=x, v=v, spacing=spacing, length=length, stable=stable,
+                   point=point)
     bas = None
     if plot is not None and grid:
         from ..analysis.basins import basins
