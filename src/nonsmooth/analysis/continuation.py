@@ -512,15 +512,17 @@ def _start_state(setup, p, orb, state):
     return s
 
 
-def _locate(br, typ, y0, t0, ds, a, b):
-    """Illinois on the arclength s in (0, ds) from y0 along t0 for a zero of test ``typ``;
-    returns (lam, multiplier nearest the crossing, y) or None."""
+def locate_on_arc(br, y0, t0, ds, a, b, test, close, seen=None):
+    """Illinois on the arclength s in (0, ds) from y0 along t0 for a zero of ``test(features)``
+    (``a`` at 0 and ``b`` at ds, of opposite signs), every trial point corrected onto the
+    branch ``br``; stops once ``close(hi - lo, y)`` or the test is 0; ``seen(features, below)``
+    is told each trial point's side. Returns (y, features) of the last trial point, or None
+    where the corrector fails."""
     # Illinois in the normalised test g = f sign(f(ds)): g(0) > 0 (lo side), g(ds) < 0 (hi)
     sg = -1.0 if b > 0 else 1.0
     lo, hi, glo, ghi = 0.0, ds, sg * a, sg * b
     side = 0
     best = None
-    mu_sides = [None, None]  # multipliers at the last point found on each side
     for _ in range(60):
         s = illinois_point(lo, hi, glo, ghi)
         got = br.correct(y0 + s * t0, t0, y0)
@@ -528,13 +530,29 @@ def _locate(br, typ, y0, t0, ds, a, b):
             return None
         y, ev, _ = got
         f = br.features(y, ev, br.tangent(ev, t0))
-        gs = sg * f["tests"][typ]
+        gs = sg * test(f)
         best = (y, f)
-        mu_sides[1 if gs < 0.0 else 0] = f["mu"]
+        if seen is not None:
+            seen(f, gs < 0.0)
         lo, hi, glo, ghi, side = illinois_update(lo, hi, glo, ghi, side, s, gs)
-        if (abs(t0[-1]) * (hi - lo) <= LOCATE_TOL * max(1.0, abs(y[-1]))) or gs == 0.0:
+        if close(hi - lo, y) or gs == 0.0:
             break
-    y, f = best
+    return best
+
+
+def _locate(br, typ, y0, t0, ds, a, b):
+    """Illinois on the arclength s in (0, ds) from y0 along t0 for a zero of test ``typ``;
+    returns (lam, multiplier nearest the crossing, y) or None."""
+    mu_sides = [None, None]  # multipliers at the last point found on each side
+
+    def seen(f, below):
+        mu_sides[1 if below else 0] = f["mu"]
+    got = locate_on_arc(br, y0, t0, ds, a, b, lambda f: f["tests"][typ],
+                        lambda width, y: abs(t0[-1]) * width <= LOCATE_TOL * max(1.0, abs(y[-1])),
+                        seen)
+    if got is None:
+        return None
+    y, f = got
     mu = f["mu"]
     target = {FOLD: 1.0, PERIOD_DOUBLING: -1.0}.get(typ)
     if target is not None:

@@ -43,7 +43,7 @@ from ..models.base import KERNEL_GENERIC
 from ..simulate import component_variables
 from ..tangent import TangentSetup, period_map
 from .continuation import (FOLD, GRAZING, LOCATE_TOL, NEIMARK_SACKER, PERIOD_DOUBLING,
-                           _accepted, _follow, bordered_step, branch_arguments)
+                           _accepted, _follow, bordered_step, branch_arguments, locate_on_arc)
 from .stability import _active, _section_state
 
 
@@ -219,33 +219,29 @@ def _codim2(br, pts, kind, N):
     return out
 
 
+class _NotFinite(Exception):
+    pass
+
+
 def _locate_codim2(br, start, y_end, kind, j, a, b):
     """The point between ``start`` = (y0, features) and ``y_end`` where codimension-two test
-    ``j`` is zero (Illinois on the arclength along the start's tangent), or None."""
-    from ..integrate.roots import illinois_point, illinois_update
-
+    ``j`` is zero (``continuation.locate_on_arc`` along the start's tangent), or None."""
     y0, f0 = start
     t0 = f0["t"]
     ds = float(t0 @ (y_end - y0))  # the corrector keeps t0 . (y - y0) = the step
     if not ds > 0.0:
         return None
-    sg = -1.0 if b > 0 else 1.0  # Illinois in g = f sign: g(0) > 0, g(ds) < 0
-    lo, hi, glo, ghi, side = 0.0, ds, sg * a, sg * b, 0
-    best = None
-    for _ in range(60):
-        s = illinois_point(lo, hi, glo, ghi)
-        got = br.correct(y0 + s * t0, t0, y0)
-        if got is None:
-            return None
-        y, ev, _ = got
-        g = _codim2_tests(br.features(y, ev, t0)["mu"], kind)[j]
+
+    def test(f):
+        g = _codim2_tests(f["mu"], kind)[j]
         if not math.isfinite(g):
-            return None
-        best = y
-        lo, hi, glo, ghi, side = illinois_update(lo, hi, glo, ghi, side, s, sg * g)
-        if hi - lo <= LOCATE_TOL or g == 0.0:
-            break
-    return best
+            raise _NotFinite
+        return g
+    try:
+        got = locate_on_arc(br, y0, t0, ds, a, b, test, lambda width, y: width <= LOCATE_TOL)
+    except _NotFinite:
+        return None
+    return None if got is None else got[0]
 
 
 def _cusps(pts, N):

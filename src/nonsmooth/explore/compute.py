@@ -65,11 +65,15 @@ class Orbit:
         return f"{per}{lam}{', ' + self.motion if self.motion else ''}"
 
 
+def first_line(exc) -> str:
+    """An exception's message in one line (its type where it has none)."""
+    return str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+
+
 def _failed(names, exc) -> Orbit:
     empty = np.zeros(0)
-    msg = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
     return Orbit(t=empty, u={n: empty for n in names}, mode=np.zeros(0, np.int8),
-                 section={n: empty for n in names}, status=f"failed: {msg}")
+                 section={n: empty for n in names}, status=f"failed: {first_line(exc)}")
 
 
 def current_orbit(params, method: str, u0, *, transient: int = VIEW_TRANSIENT,

@@ -72,8 +72,12 @@ def _allowed(model, values: dict, name: str, x: float) -> bool:
 
 def _one_line(exc) -> str:
     """An exception's first line, escaped for a Div's HTML."""
-    text = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
-    return html.escape(text)
+    return html.escape(compute.first_line(exc))
+
+
+def _label(prm) -> str:
+    """A parameter field's title: its name, and its units where it has some."""
+    return f"{prm.name} [{prm.units}]" if prm.units not in ("", "1") else prm.name
 
 
 def _fmt(v: float) -> str:
@@ -96,11 +100,14 @@ class Explorer:
         self._drawn_gen = 0
         self._show_names = show
         self.message = Div(text="", name="message", styles={"color": "#b00020"})
-        self._view_worker = compute.LatestWorker(self._compute_view, self._deliver(self._show_view),
-                                                 "explore-view")
-        self._slice_worker = compute.LatestWorker(self._compute_slice,
-                                                  self._deliver(self._show_slice), "explore-slice",
-                                                  defer_to=self._view_worker)
+        self._view_worker = compute.LatestWorker(
+            self._compute_view,
+            self._deliver("_view_worker", self._show_view, "status", "failed: "), "explore-view")
+        self._slice_worker = compute.LatestWorker(
+            self._compute_slice,
+            self._deliver("_slice_worker", self._show_slice, "slice_status",
+                          "orbit diagram failed: "),
+            "explore-slice", defer_to=self._view_worker)
         self._build_static()
         self.load_model(model, method=method, preset=preset, sets=sets, slice_param=slice_param)
         doc.add_root(self.layout)
@@ -112,9 +119,19 @@ class Explorer:
         self._view_worker.stop()
         self._slice_worker.stop()
 
-    def _deliver(self, apply):
+    def _deliver(self, worker: str, apply, status: str, failed: str):
+        """A worker's ``deliver``: on the page's next tick, drop a result of a request that is
+        no longer the newest, show a failure in the Div ``status``, else ``apply`` it."""
+        def show(gen, value):
+            if not getattr(self, worker).alive(gen):
+                return
+            if isinstance(value, Exception):
+                getattr(self, status).text = f"{failed}{_one_line(value)}"
+                return
+            apply(gen, value)
+
         def deliver(gen, value):
-            self.doc.add_next_tick_callback(partial(apply, gen, value))
+            self.doc.add_next_tick_callback(partial(show, gen, value))
         return deliver
 
     def _params(self):
@@ -252,8 +269,7 @@ class Explorer:
         for prm in self.model.parameters:
             v = self.values[prm.name]
             lo, hi = slider_range(prm, v)
-            label = f"{prm.name} [{prm.units}]" if prm.units not in ("", "1") else prm.name
-            field = TextInput(title=label, value=_fmt(v), name=f"param_{prm.name}", width=120)
+            field = TextInput(title=_label(prm), value=_fmt(v), name=f"param_{prm.name}", width=120)
             slider = Slider(start=lo, end=hi, value=min(max(v, lo), hi),
                             step=(hi - lo) / SLIDER_STEPS, title="", show_value=False,
                             name=f"slider_{prm.name}", width=200)
@@ -306,9 +322,6 @@ class Explorer:
             self.request_view()
             self.request_slice()
 
-    def _label(self, prm):
-        return f"{prm.name} [{prm.units}]" if prm.units not in ("", "1") else prm.name
-
     def _on_field(self, prm, attr, old, new):
         field = self.fields[prm.name]
         try:
@@ -317,7 +330,7 @@ class Explorer:
         except ParameterError as exc:
             field.title = f"⚠ {str(exc).splitlines()[0]}"     # a title is text, not HTML
             return
-        field.title = self._label(prm)
+        field.title = _label(prm)
         self.set_param(prm.name, v, from_field=True)
 
     def _on_slider(self, prm, attr, old, new):
@@ -426,16 +439,11 @@ class Explorer:
         self.slice_status.text = f"orbit diagram: 0 of {n} values"
         component = self.pair[0] if self.pair[0] in (0, 1) else 0
         self.slice_fig.yaxis.axis_label = f"{self.model.state_names[component]} on the section"
-        self._slice_gen = self._slice_worker.submit(params, self.method, name,
+        self._slice_worker.submit(params, self.method, name,
                                                     np.linspace(lo, hi, n), list(self.u0),
                                                     component)
 
     def _show_view(self, gen, orbit):
-        if not self._view_worker.alive(gen):
-            return
-        if isinstance(orbit, Exception):
-            self.status.text = f"failed: {_one_line(orbit)}"
-            return
         summary = (f"{html.escape(orbit.summary())} <span style='color:#888'>"
                    f"({1000 * orbit.seconds:.0f} ms)</span>")
         if gen == self._drawn_gen:      # the second stage: the same orbit with its lambda1
@@ -473,11 +481,6 @@ class Explorer:
                 s.location, s.visible = float(level), True
 
     def _show_slice(self, gen, part):
-        if not self._slice_worker.alive(gen):
-            return
-        if isinstance(part, Exception):
-            self.slice_status.text = f"orbit diagram failed: {_one_line(part)}"
-            return
         values, pts, _period = part
         vv = np.repeat(values, pts.shape[1])
         pp = pts.reshape(-1)
