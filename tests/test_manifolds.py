@@ -194,6 +194,17 @@ def test_cli_manifolds_writes_the_api_result_and_a_figure(tmp_path, capsys, fig7
     assert "saddle of period 1 at (X, V) = (-0.982138, +0.596784)" in out
     assert "homoclinic points: 0" in out and out.count("converged onto an attractor") == 2
     assert png.read_bytes()[:4] == b"\x89PNG"
+    code, out, err = run_cli(["manifolds", "--axes", "V,X", "-o", str(nc)], capsys)
+    assert code == 0, err  # the same manifolds in the plane (V, X)
+    assert "saddle of period 1 at (V, X) = (+0.596784, -0.982138)" in out
+    got = load_dataset(nc)
+    assert got.attrs["axes"] == "V X" and got.attrs["stable_method"] == \
+        fig7[2].attrs["stable_method"]
+    for b in (2, 3):
+        assert _near_polyline(_branch(fig7[2], b), _branch(got, b)) < 1e-5
+    code, out, err = run_cli(["manifolds", "--axes", "X,Q"], capsys)
+    assert code == 2
+    one_line(err, "axes: unknown component 'Q'")
     code, out, err = run_cli(["manifolds", "--x0", "50", "--v0", "50"], capsys)
     assert code == 1
     one_line(err, "no period-1 orbit found")
@@ -231,3 +242,82 @@ def test_the_manifolds_of_each_point_of_a_period_two_saddle_are_images_of_each_o
     assert max(gaps) < spacing / 10 and np.median(gaps) < 1e-5  # chords' sagitta; 8e-6
     with pytest.raises(ParameterError, match="point: a period-2 orbit has section points 0"):
         ns.manifolds(p, orbit, point=2, **kw)
+
+
+def double_well_with_oscillator():
+    """The double well of double_well() and a damped linear oscillator (Y, W), coupled both
+    ways by eps: a four-dimensional section."""
+    return ns.model_from_equations(
+        "double_well_4", states=("X", "V", "Y", "W"),
+        parameters={"delta": 0.15, "F0": 0.25, "omega": 1.0, "eps": 0.0},
+        modes={"free": ["V", "-delta*V + X - X**3 + F0*cos(omega*t) + eps*(Y - X)",
+                        "W", "-0.4*W - Y + eps*(X - Y)"]}, method="smooth")
+
+
+from nonsmooth.analysis.manifolds import BRANCH_NAMES as BRANCHES  # noqa: E402
+
+
+def _near_polyline(W, pts):
+    """Largest distance from the rows of pts to the polyline W."""
+    return max(_distance_to(q, W) for q in pts)
+
+
+def test_the_stable_manifold_of_a_four_dimensional_section_is_traced_in_a_plane():
+    """n > 2: the saddle's stable manifold is a hypersurface of the section, traced where it
+    meets the plane of two components through the saddle. Oracles: uncoupled (eps = 0) it is
+    W^s(double well) x R^2, so its trace in (X, V) is the double well's own stable manifold
+    and its trace in (X, Y) the line X = X* (V = V*); coupled (eps = 0.2) the trace in (X, V)
+    is the boundary that basins draws in that plane through the saddle."""
+    kw = dict(x=(-2, 2), v=(-1.5, 1.5), length=3.0, spacing=0.05, max_search=60)
+    p2 = double_well().params(delta=0.05, F0=0.03)
+    o2 = ns.periodic_orbit(p2, x0=-0.015, v0=0.0, method="smooth")
+    d2 = ns.manifolds(p2, o2, **kw)
+    m4 = double_well_with_oscillator()
+    p4 = m4.params(delta=0.05, F0=0.03)
+    o4 = ns.periodic_orbit(p4, u0=[-0.015, 0.0, 0.0, 0.0], method="smooth")
+    assert o4.attrs["converged"] == 1 and o4.sizes["multiplier"] == 4
+    d4 = ns.manifolds(p4, o4, **kw)
+    assert "trace of the 3-dimensional stable manifold in the plane (X, V)" in \
+        d4.attrs["stable_method"]
+    for b in (2, 3):  # the same curve, to the search's tolerance (measured 8e-12)
+        W2, W4 = _branch(d2, b), _branch(d4, b)
+        assert len(W4) > 50 and _near_polyline(W2, W4) < 1e-6
+        assert np.all(d4.Y.values[d4.branch.values == b] == 0.0)
+    for b in (0, 1):  # the unstable branches too (4-D integration: its own steps)
+        assert _near_polyline(_branch(d2, b), _branch(d4, b)[::10]) < 1e-4
+    # (beyond |Y| = 0.88 its points leave the saddle before they reach its box: "lost")
+    xy = ns.manifolds(p4, o4, axes="X,Y", x=(-2, 2), v=(-1, 1), length=0.6, spacing=0.05,
+                      max_search=60)
+    assert xy.attrs["axes"] == "X Y" and xy.component_index.values.tolist() == ["X", "Y"]
+    for b in (2, 3):
+        sel = xy.branch.values == b
+        assert xy.attrs[f"status_{BRANCHES[b]}"] == "length: 0.6 reached"
+        assert sel.sum() > 15 and np.ptp(xy.Y.values[sel]) > 0.59
+        assert np.max(np.abs(xy.X.values[sel] - float(xy.saddle_X))) < xy.attrs["tol"]  # 1.2e-6
+        assert np.all(xy.V.values[sel] == float(xy.saddle_V))
+
+    # coupled: the trace is the boundary of the basins in its plane
+    p = m4.params(delta=0.6, F0=0.1, eps=0.2)
+    o = ns.periodic_orbit(p, u0=[0.0, 0.0, 0.0, 0.0], method="smooth")
+    d = ns.manifolds(p, o, x=(-2, 2), v=(-2, 2))
+    assert d.attrs["status_stable_plus"] == d.attrs["status_stable_minus"] == "left the window"
+    zs = [float(c) for c in ns.io.components(d, prefix="saddle_").values]
+    assert abs(zs[2]) > 1e-3  # the plane's fixed components are not zero
+    b = ns.basins(p, x=(-2, 2), v=(-2, 2), grid=60, method="smooth", lyapunov=False,
+                  axes=("X", "V"), u0=zs)
+    lab = b.label.values
+    assert set(np.unique(lab)) == {0, 1}
+    x0, v0 = b.x0.values, b.v0.values
+    W = np.concatenate([_branch(d, 2), _branch(d, 3)])
+    inside = (np.abs(W[:, 0]) <= 2) & (np.abs(W[:, 1]) <= 2)
+    assert inside.sum() > 200
+    for x, v in W[inside]:
+        i = int(round((x - x0[0]) / (x0[1] - x0[0])))
+        j = int(round((v - v0[0]) / (v0[1] - v0[0])))
+        assert len(np.unique(lab[max(0, i - 2):i + 3, max(0, j - 2):j + 3])) == 2, (x, v)
+
+    with pytest.raises(ParameterError, match="orbit: the first homoclinic tangency is sought "
+                                             "for a two-dimensional section"):
+        ns.homoclinic_tangency(p4, o4, "F0", (0.03, 0.045))
+    with pytest.raises(ParameterError, match="axes: unknown component 'Z'"):
+        ns.manifolds(p4, o4, axes="X,Z")

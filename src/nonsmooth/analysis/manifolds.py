@@ -35,6 +35,12 @@ sides, the step halved where no such pair is found or the curve turns by more th
 window, at ``length`` or ``max_points``, or where its points can no longer be classified
 (they do not reach the saddle within ``max_search`` iterates of the map).
 
+**Sections of more than two coordinates** (n > 2, or a memory slot the map depends on): the
+unstable manifold is grown as above in the full section; the stable manifold, of dimension
+one less than the section's, is traced where it meets a plane of two state components through
+the saddle (the others held at the saddle's values), by the same search, starting along the
+line where the plane meets the stable subspace (c_u = 0).
+
 **Homoclinic points.** Transversal crossings of a stable and an unstable branch (segment
 intersections of the two polylines, away from z*) are reported with their crossing angle; a
 small angle marks a near tangency. A first homoclinic tangency along a parameter lies between
@@ -51,12 +57,13 @@ import xarray as xr
 
 from .. import status as st
 from ..errors import ParameterError
-from ..integrate.contract import ST_V, ST_X
-from ..io import apply_state_units, components, provenance_attrs
+from ..integrate.contract import ST_EXTRA, ST_V, ST_X
+from ..io import apply_state_units, component_names, components, provenance_attrs
 from ..kernels import new_state, output_buffers, run
 from ..models.base import KERNEL_GENERIC
 from ..simulate import check_float, check_int, check_params, component_variables
 from ..tangent import TangentSetup
+from .basins import _check_axes
 from .basins._core import _map_points, _one_interval
 from .stability import _active
 
@@ -64,14 +71,16 @@ BRANCH_NAMES = ("unstable_plus", "unstable_minus", "stable_plus", "stable_minus"
 
 
 @nb.njit(cache=True, parallel=True)
-def _exit_sides(method, fns, p, opts, states, q, zs, Einv, r, r_lo, max_iter, side, used):
+def _exit_sides(method, fns, p, opts, states, q, idx, zs, Einv, r, r_lo, max_iter, side, used):
     """For each state (at a period boundary): the side (+1 / -1, the sign of c_u) on which its
     orbit under the q-period map leaves the saddle zs after having entered its box
-    |c_u|, |c_s| < r ((c_u, c_s) = Einv (z - zs)): where |c_u| >= r, or already where
-    |c_u| >= r_lo >= |c_s| (r_lo = r / (2 lambda): a strongly expanding saddle carries a point
-    from inside the box far beyond it in one map; there the local stable manifold,
-    c_u = O(c_s^2), is far below r_lo). 0 if it does not within max_iter maps or its
-    integration fails. used[i]: the maps it took."""
+    |c_i| < r ((c_0 = c_u, c_1, ...) = Einv (z - zs), z the section coordinates at the kernel
+    state positions idx): where |c_u| >= r, or already where |c_u| >= r_lo >= max |c_i>0|
+    (r_lo = r / (2 lambda): a strongly expanding saddle carries a point from inside the box
+    far beyond it in one map; there the local stable manifold, c_u = O(|c_s|^2), is far below
+    r_lo). 0 if it does not within max_iter maps or its integration fails. used[i]: the maps
+    it took."""
+    m = idx.shape[0]
     for i in nb.prange(states.shape[0]):
         ox, ov, orr, om, oxa, oxi = _one_interval()
         entered = False
@@ -83,15 +92,24 @@ def _exit_sides(method, fns, p, opts, states, q, zs, Einv, r, r_lo, max_iter, si
                 used[i] = j
                 if s != 0:
                     break
-            dx = states[i, ST_X] - zs[0]
-            dv = states[i, ST_V] - zs[1]
-            cu = Einv[0, 0] * dx + Einv[0, 1] * dv
-            cs = Einv[1, 0] * dx + Einv[1, 1] * dv
-            if not (math.isfinite(cu) and math.isfinite(cs)):
+            cu = 0.0
+            cs = 0.0  # the largest |c| of the other coordinates
+            finite = True
+            for a in range(m):
+                c = 0.0
+                for b in range(m):
+                    c += Einv[a, b] * (states[i, idx[b]] - zs[b])
+                if not math.isfinite(c):
+                    finite = False
+                if a == 0:
+                    cu = c
+                else:
+                    cs = max(cs, abs(c))
+            if not finite:
                 break
-            if abs(cu) < r and abs(cs) < r:
+            if abs(cu) < r and cs < r:
                 entered = True
-            if entered and (abs(cu) >= r or (abs(cu) >= r_lo and abs(cs) <= r_lo)):
+            if entered and (abs(cu) >= r or (abs(cu) >= r_lo and cs <= r_lo)):
                 side[i] = 1 if cu > 0 else -1
                 break
 
@@ -109,6 +127,8 @@ class _Map:
                       if window else math.inf)
         self.lam = 1.0  # the unstable multiplier of the q-period map
         self.zfill = None  # the saddle's section point (components the stable search fixes)
+        self.plane = (0, 1)  # the section coordinates the stable search varies
+        self.idx = None  # kernel state positions of the active section coordinates
         self.periods = 0  # forcing periods integrated (work done)
 
     def states(self, Z):
@@ -132,15 +152,22 @@ class _Map:
         return out
 
     def sides(self, Z, zs, Einv, r, max_iter):
-        """Exit sides (see _exit_sides) of the points Z (rows (X, V); the further section
-        components, inactive, are the saddle's)."""
+        """Exit sides (see _exit_sides) of the points Z: rows in the plane's two coordinates
+        (``self.plane``), the further section coordinates the saddle's (``self.zfill``)."""
         full = np.repeat(self.zfill[None, :], len(Z), axis=0)
-        full[:, :Z.shape[1]] = Z
-        states = self.states(full)
+        full[:, list(self.plane)] = Z
+        return self.sides_full(full, zs, Einv, r, max_iter)
+
+    def sides_full(self, Z, zs, Einv, r, max_iter):
+        """Exit sides of the section points Z (rows z): zs and Einv on the active
+        coordinates (kernel state positions ``self.idx``)."""
+        states = self.states(Z)
         side = np.zeros(len(Z), np.int64)
         used = np.zeros(len(Z), np.int64)
-        _exit_sides(self.solver.code, self.setup.fns, self.p, self.setup.opts, states, self.q,
-                    zs, Einv, r, r / (2.0 * self.lam), max_iter, side, used)
+        if len(Z):
+            _exit_sides(self.solver.code, self.setup.fns, self.p, self.setup.opts, states,
+                        self.q, self.idx, zs, Einv, r, r / (2.0 * self.lam), max_iter, side,
+                        used)
         self.periods += int(used.sum()) * self.q
         return side
 
@@ -240,7 +267,9 @@ def _unstable_branch(mp: _Map, zs, e, lam, sign, delta, spacing, max_angle, leng
             mark = (d > spacing) | (sharp & (d > fine))
             # both ends beyond the window by more than the chord: the curve between cannot
             # reach the window (for a chord of bounded curvature) and is not refined
-            out = _outside(Q, mp.window, np.r_[d, 0.0]) & _outside(Q, mp.window, np.r_[0.0, d])
+            Qp = Q[:, list(mp.plane)]
+            out = (_outside(Qp, mp.window, np.r_[d, 0.0])
+                   & _outside(Qp, mp.window, np.r_[0.0, d]))
             mark &= ~(out[:-1] & out[1:])
             fine_enough = np.diff(S) > 1e-13
             coarse += int(np.count_nonzero(mark & ~fine_enough & (d > spacing)))
@@ -277,7 +306,8 @@ def _unstable_branch(mp: _Map, zs, e, lam, sign, delta, spacing, max_angle, leng
             end = P[-1]
             status = "converged onto an attractor"
             break
-        if mp.window is not None and np.all(_outside(Q, mp.window, mp.reach)):
+        if mp.window is not None and np.all(_outside(Q[:, list(mp.plane)], mp.window,
+                                                     mp.reach)):
             # beyond the window by more than half its size (nearer, later levels may come
             # back into it and are followed, unrefined outside it)
             pts[-1], ts[-1] = P, j + S
@@ -339,10 +369,11 @@ def _around(mp, c, tang, rad, zs, Einv, r, max_iter, tol, n: int = 72):
     return _bisect(mp, Z[i], Z[j], sides[i], zs, Einv, r, max_iter, tol)
 
 
-def _stable_branch(mp: _Map, zs, e_s, Einv, sign, delta, spacing, max_angle, length, max_points,
-                   r, max_iter, tol):
-    """Points of one stable branch (rows (X, V)) and the status."""
-    W = [zs.copy(), zs + sign * delta * e_s]
+def _stable_branch(mp: _Map, start, zs, e_s, Einv, sign, delta, spacing, max_angle, length,
+                   max_points, r, max_iter, tol):
+    """Points of one stable branch (rows in the plane's coordinates, from the saddle's point
+    ``start`` along ``e_s``) and the status; zs and Einv classify (active coordinates)."""
+    W = [start.copy(), start + sign * delta * e_s]
     h = min(spacing, 10.0 * delta)
     h_min = max(tol * 10.0, 1e-4 * spacing)
     total = delta
@@ -486,7 +517,7 @@ def manifolds(params, orbit, *, x=None, v=None, spacing: float | None = None,
               delta: float | None = None, max_angle: float = 0.3, length: float | None = None,
               iterates: int | None = None, max_points: int = 4000, stable: bool = True,
               radius: float | None = None, max_search: int = 100,
-              tol: float | None = None, point: int = 0) -> xr.Dataset:
+              tol: float | None = None, point: int = 0, axes=None) -> xr.Dataset:
     """The stable and unstable manifolds of the saddle ``orbit`` (a converged
     :func:`nonsmooth.periodic_orbit` of ``params``, same model and parameters; its method, k,
     tolerances and section phase are used) as polylines, by the methods of the module
@@ -500,12 +531,20 @@ def manifolds(params, orbit, *, x=None, v=None, spacing: float | None = None,
     branch (default 4 window diagonals, else 100 spacings); ``iterates``: the most
     iterates of a fundamental domain (unstable; default 100 more than it takes the multiplier
     to carry delta to ``length``); ``max_points`` per branch; ``stable``: also
-    the stable manifold (needs a two-dimensional section); ``radius``: the saddle's
+    the stable manifold (in a section of more than two coordinates, its trace in the plane
+    of ``axes`` through the saddle); ``radius``: the saddle's
     neighbourhood in the classification (default 5 spacings); ``max_search``: iterates of the
     map before a point is called unclassified; ``tol``: the stable points' accuracy across
     the curve (default spacing / 10^4); ``point``: which of a period-k saddle's k section
     points the manifolds belong to (default 0; the orbit is re-centred there by Newton
-    shooting, its monodromy taken there: the manifolds of point j are those of P^k at z_j).
+    shooting, its monodromy taken there: the manifolds of point j are those of P^k at z_j);
+    ``axes``: the two state components of the window and of the stable search (default the
+    first two; e.g. ("X", "Y") or "X,Y"). Where the section has more than two coordinates
+    (n > 2, or an active memory slot) the stable manifold of a saddle with one unstable
+    multiplier is a hypersurface: what is grown is the curve where it meets the plane of
+    ``axes`` through the saddle (the other coordinates held at the saddle's, as ``basins``
+    with ``axes`` and ``u0`` = the saddle's point draws its boundary), and homoclinic points
+    are not sought there.
 
     Returns a Dataset over ``point`` (all branches one after the other): ``X``, ``V`` (and the
     further state components), ``branch`` (flag: unstable_plus, unstable_minus, stable_plus,
@@ -522,12 +561,13 @@ def manifolds(params, orbit, *, x=None, v=None, spacing: float | None = None,
         raise ParameterError(f"manifolds: model {m.name} declares no forcing; the manifolds "
                              f"here are those of the stroboscopic map")
     window = _check_window(x, v)
+    plane = _check_axes(m, axes, None)[:2]
     orbit = _centred(params, orbit, point)
     solver, setup, k, p, zs, act, mu, E = _saddle(params, orbit)
     diag = (math.hypot(window[0][1] - window[0][0], window[1][1] - window[1][0])
             if window else None)
     spacing = (_positive("spacing", spacing) if spacing is not None
-               else diag / 200.0 if diag else 0.01 * (1.0 + float(np.linalg.norm(zs[:2]))))
+               else diag / 200.0 if diag else 0.01 * (1.0 + float(np.linalg.norm(zs[list(plane)]))))
     delta = _positive("delta", delta) if delta is not None else spacing / 1000.0
     max_angle = _positive("max_angle", max_angle)
     length = (_positive("length", length) if length is not None
@@ -544,16 +584,15 @@ def manifolds(params, orbit, *, x=None, v=None, spacing: float | None = None,
     N = setup.N
     e_u = np.zeros(N)
     e_u[act] = E[:, iu].real / np.linalg.norm(E[:, iu].real)
-    if stable and (int(act.sum()) != 2 or m.n != 2):
-        raise ParameterError(f"stable: the stable manifold is a curve only for a "
-                             f"two-dimensional section; this one has {int(act.sum())} "
-                             f"components (give stable=False)")
+    planar = int(act.sum()) == 2  # the section is the plane (X, V) itself
     if iterates is None:  # enough levels to carry the fundamental domain across the window
         iterates = 100 + int(math.ceil(math.log(max(length, 10 * spacing) / delta)
                                        / math.log(abs(lam))))
     mp = _Map(setup, solver, p, q, window)
     mp.zfill = zs
     mp.lam = abs(lam)
+    mp.plane = plane
+    mp.idx = _state_positions(setup)[act]
     nshow = m.n
     branches, statuses, ends, levels = [], [], [], []
     for sign in (1.0, -1.0):
@@ -563,50 +602,105 @@ def manifolds(params, orbit, *, x=None, v=None, spacing: float | None = None,
         levels.append(T)
         statuses.append(status)
         ends.append(end[:nshow] if end is not None else np.full(nshow, np.nan))
-    e_s = np.full(N, np.nan)
+    e_s = np.full(2, np.nan)
     stable_method = ""
+    cross = []
     if stable:
-        i_s = 1 - iu
-        if abs(mu[i_s].imag) > 0.0:
-            raise ParameterError("orbit: complex stable multipliers")
-        e_s = E[:, i_s].real / np.linalg.norm(E[:, i_s].real)
-        Ea = np.column_stack([e_u[act], e_s])
-        Einv = np.linalg.inv(Ea)
+        za = zs[act]
+        Einv, e_s = _stable_coordinates(E, mu, iu, e_u[act], act, plane, planar)
         stable_method = ("search: each point bisected across the curve between initial "
                          "conditions that leave the saddle along opposite unstable branches "
                          "(no inverse map)")
+        if not planar:
+            names = component_names(m.state_names)
+            stable_method += (f"; the trace of the {int(act.sum()) - 1}-dimensional stable "
+                              f"manifold in the plane ({names[plane[0]]}, {names[plane[1]]}) "
+                              f"through the saddle, the other coordinates the saddle's; "
+                              f"homoclinic points not sought (the trace is not the manifold)")
         for sign in (1.0, -1.0):
-            W, status = _stable_branch(mp, zs[act], e_s, Einv, sign, delta, spacing, max_angle,
-                                       length, max_points, radius, max_search, tol)
-            branches.append(W)
+            W, status = _stable_branch(mp, zs[list(plane)], za, e_s, Einv, sign, delta,
+                                       spacing, max_angle, length, max_points, radius,
+                                       max_search, tol)
+            full = np.repeat(zs[None, :nshow], len(W), axis=0)
+            full[:, list(plane)] = W
+            branches.append(full)
             levels.append(np.full(len(W), np.nan))
             statuses.append(status)
             ends.append(np.full(nshow, np.nan))
-    cross = []
-    if stable:  # (inside the window: outside it the branches are not refined)
-        for a in (0, 1):
-            for b in (2, 3):
-                for pt, ang, i, j in _crossings(branches[a][:, :2], branches[b][:, :2]):
-                    if window is None or _inside(pt[None, :], window)[0]:
-                        cross.append((pt, ang, a, b))
-    return _dataset(params, solver, k, q, zs[:nshow], mu, e_u[act], e_s, branches, levels,
-                    statuses, ends, cross, stable_method, dict(
+        # homoclinic points (inside the window: outside it the branches are not refined)
+        if planar:  # crossings of the unstable and the stable polylines
+            for a in (0, 1):
+                for b in (2, 3):
+                    for pt, ang, i, j in _crossings(branches[a][:, list(plane)],
+                                                    branches[b][:, list(plane)]):
+                        row = np.zeros(nshow)
+                        row[list(plane)] = pt
+                        cross.append((row, ang, a, b))
+        cross = [c for c in cross if window is None
+                 or _inside(c[0][None, list(plane)], window)[0]]
+    return _dataset(params, solver, k, q, zs[:nshow], mu, e_u, e_s, branches, levels,
+                    statuses, ends, cross, stable_method, plane, dict(
                         spacing=spacing, delta=delta, max_angle=max_angle, length=length,
                         iterates=iterates, max_points=max_points, radius=radius,
                         max_search=max_search, tol=tol, periods_integrated=mp.periods,
                         orbit_point=int(point)))
 
 
+def _state_positions(setup: TangentSetup):
+    """The kernel state position of each section coordinate z (as TangentSetup.z_of reads
+    them)."""
+    n = setup.n
+    pos = [ST_X, ST_V] + [ST_EXTRA + i for i in range(n - 2)]
+    pos += [ST_EXTRA + n - 2 + int(i) for i in setup.cmi]
+    return np.asarray(pos, np.int64)
+
+
+def _stable_coordinates(E, mu, iu, e_u, act, plane, planar):
+    """(Einv, e_s): the inverse of the real eigenbasis of the active coordinates (row 0 the
+    unstable coordinate c_u, the others spanning the stable subspace; a complex pair by its
+    real and imaginary parts) and the stable direction in the plane: the stable eigenvector
+    for a planar section, else the line where the plane meets the stable subspace (c_u = 0)."""
+    cols = [e_u]
+    seen = set()
+    for i in range(len(mu)):
+        if i == iu or i in seen:
+            continue
+        v = E[:, i]
+        if abs(mu[i].imag) > 0.0:
+            if planar:
+                raise ParameterError("orbit: complex stable multipliers")
+            j = next((j for j in range(len(mu)) if j != i and j not in seen and
+                      abs(mu[j] - np.conj(mu[i])) <= 1e-12 * abs(mu[i])), None)
+            if j is not None:
+                seen.add(j)
+            cols += [v.real / np.linalg.norm(v.real), v.imag / np.linalg.norm(v.imag)]
+        else:
+            cols.append(v.real / np.linalg.norm(v.real))
+    Einv = np.linalg.inv(np.column_stack(cols[:len(mu)]))
+    at = np.flatnonzero(act)
+    pa, pb = (int(np.flatnonzero(at == c)[0]) for c in plane)
+    if planar:
+        return Einv, cols[1][[pa, pb]]
+    lu = Einv[0]
+    d = np.array([-lu[pb], lu[pa]])
+    if not np.linalg.norm(d) > 1e-9 * np.linalg.norm(lu):
+        raise ParameterError("axes: the plane lies in the saddle's stable subspace (no curve "
+                             "to trace there); choose other axes")
+    return Einv, d / np.linalg.norm(d)
+
+
 def _dataset(params, solver, k, q, zs, mu, e_u, e_s, branches, levels, statuses, ends, cross,
-             stable_method, settings):
+             stable_method, plane, settings):
     m = params.model
+    cnames = component_names(m.state_names)
+    axes = [cnames[i] for i in plane]
     U = np.concatenate(branches)
     flag = np.concatenate([np.full(len(b), i, np.int8) for i, b in enumerate(branches)])
     nb_ = len(branches)
     names = BRANCH_NAMES[:nb_]
     E = np.array(ends)
     order = np.argsort(-np.abs(mu), kind="stable")
-    cp = np.array([c[0] for c in cross]).reshape(-1, 2)
+    cp = np.array([c[0] for c in cross]).reshape(-1, m.n)
     ds = xr.Dataset(
         {
             "X": ("point", U[:, 0], {"long_name": "X on the manifold (at the section)"}),
@@ -626,11 +720,12 @@ def _dataset(params, solver, k, q, zs, mu, e_u, e_s, branches, levels, statuses,
             "saddle_V": ((), float(zs[1]), {"long_name": "V of the saddle's section point"}),
             "multiplier_real": ("multiplier", mu[order].real, {"units": "1"}),
             "multiplier_imag": ("multiplier", mu[order].imag, {"units": "1"}),
-            "unstable_direction": ("component_index", e_u[:2], {
-                "long_name": "unit eigenvector of the unstable multiplier (X, V)",
-                "units": "1"}),
-            "stable_direction": ("component_index", np.asarray(e_s[:2], float), {
-                "long_name": "unit eigenvector of the stable multiplier (X, V)", "units": "1"}),
+            "unstable_direction": ("component_index", e_u[list(plane)], {
+                "long_name": "unit eigenvector of the unstable multiplier (its components "
+                             "in the plane)", "units": "1"}),
+            "stable_direction": ("component_index", np.asarray(e_s, float), {
+                "long_name": "unit tangent of the stable branches at the saddle, in the "
+                             "plane", "units": "1"}),
             "crossing_X": ("crossing", cp[:, 0], {"long_name": "X of a homoclinic point"}),
             "crossing_V": ("crossing", cp[:, 1], {"long_name": "V of a homoclinic point"}),
             "crossing_angle": ("crossing", np.array([c[1] for c in cross], float), {
@@ -639,20 +734,27 @@ def _dataset(params, solver, k, q, zs, mu, e_u, e_s, branches, levels, statuses,
                 "long_name": "the unstable branch", "flag_values": np.arange(nb_, dtype=np.int8),
                 "flag_meanings": " ".join(names)}),
             "crossing_stable": ("crossing", np.array([c[3] for c in cross], np.int8), {
-                "long_name": "the stable branch", "flag_values": np.arange(nb_, dtype=np.int8),
+                "long_name": "the stable branch (-1: the stable manifold, a section of more "
+                             "than two coordinates)", "flag_values": np.arange(nb_, dtype=np.int8),
                 "flag_meanings": " ".join(names)}),
         },
         coords={"point": np.arange(len(U)), "branch_index": ("branch_index", np.arange(nb_), {
             "long_name": "branch", "flag_values": np.arange(nb_, dtype=np.int8),
             "flag_meanings": " ".join(names)}),
-                "multiplier": np.arange(1, len(mu) + 1), "component_index": ["X", "V"],
+                "multiplier": np.arange(1, len(mu) + 1), "component_index": axes,
                 "crossing": np.arange(len(cross))},
         attrs=provenance_attrs(params, solver, analysis="manifolds", k=k, map_periods=q,
-                               stable_method=stable_method,
+                               stable_method=stable_method, axes=" ".join(axes),
                                **{f"status_{nm}": s for nm, s in zip(names, statuses)},
                                n_crossings=len(cross), **settings),
     )
     ds.update(component_variables(m, ("point",), U, what=" on the manifold"))
+    ds.update(component_variables(m, (), np.asarray(zs), prefix="saddle_",
+                                  what=" of the saddle's section point"))
+    ds.update(component_variables(m, ("branch_index",), E, prefix="end_",
+                                  what=" where the branch converged onto an attractor (else NaN)"))
+    ds.update(component_variables(m, ("crossing",), cp, prefix="crossing_",
+                                  what=" of a homoclinic point"))
     return apply_state_units(ds, m)
 
 
@@ -689,7 +791,11 @@ def homoclinic_tangency(params, orbit, param: str, bounds, *, tol: float = 1e-4,
         if key not in known:
             raise ParameterError(f"{key}: not an option of manifolds here (known: "
                                  f"{', '.join(sorted(known))})")
-    _saddle(params, orbit)  # checks the orbit
+    act = _saddle(params, orbit)[5]  # checks the orbit
+    if int(act.sum()) != 2:
+        raise ParameterError(f"orbit: the first homoclinic tangency is sought for a "
+                             f"two-dimensional section; this one has {int(act.sum())} "
+                             f"coordinates")
     done = {float(getattr(params, name)): orbit}
     kw = dict(k=int(orbit.attrs.get("k", 1)), method=str(orbit.attrs.get("method", "exact")),
               rtol=float(orbit.attrs.get("rtol", 1e-10)), atol=float(orbit.attrs.get("atol",

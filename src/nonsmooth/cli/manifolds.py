@@ -37,6 +37,11 @@ def manifolds_cmd(
                           "the window's diagonal)")] = None,
     length: Annotated[Optional[float], typer.Option(
         "--length", help="largest arc length of a branch (default: 4 window diagonals)")] = None,
+    axes: Annotated[Optional[str], typer.Option(
+        "--axes", show_default=False,
+        help="the two state components of the window, A,B (--x and --v are their ranges); "
+             "with more than two, the stable manifold is traced in their plane through the "
+             "saddle; default: the first two")] = None,
     stable: Annotated[bool, typer.Option(
         "--stable/--no-stable", help="also the stable manifold (a search method)")] = True,
     basins_grid: Annotated[int, typer.Option(
@@ -72,22 +77,31 @@ def manifolds_cmd(
                    err=True)
         raise typer.Exit(EXIT_NOT_FOUND)
     ds = manifolds(params, orbit, x=x, v=v, spacing=spacing, length=length, stable=stable,
-                   point=point)
+                   point=point, axes=axes)
     bas = None
     if plot is not None and grid:
         from ..analysis.basins import basins
+        from ..io import component_names, components
+        state = list(params.model.state_names)
+        names = component_names(state)
+        plane = [state[names.index(c)] for c in ds.attrs["axes"].split()]
+        # the grid's plane through the saddle (its other components the saddle's)
+        extra = ({} if params.model.n == 2 and plane == state[:2] else dict(
+            axes=plane, u0=[float(c) for c in components(ds, prefix="saddle_").values]))
         bas = basins(params, x=x, v=v, grid=grid, method=method, rtol=rtol, atol=atol,
-                     lyapunov=False)
+                     lyapunov=False, section_phase=section_phase, **extra)
     from ..plot.manifolds import plot_manifolds
     save_outputs(ds, preset, out, plot, lambda d: plot_manifolds(d, basins=bas))
     mu = ds.multiplier_real.values + 1j * ds.multiplier_imag.values
-    typer.echo(f"{preset} ({method}): saddle of period {k} at (X, V) = "
-               f"({float(ds.saddle_X):+.6g}, {float(ds.saddle_V):+.6g}), multipliers "
+    ca, cb = ds.attrs["axes"].split()
+    typer.echo(f"{preset} ({method}): saddle of period {k} at ({ca}, {cb}) = "
+               f"({float(ds['saddle_' + ca]):+.6g}, {float(ds['saddle_' + cb]):+.6g}), "
+               f"multipliers "
                + ", ".join(f"{m.real:.6g}" if m.imag == 0 else f"{m:.6g}" for m in mu))
     flag = ds.branch.values
     rows = []
     for b in range(ds.sizes["branch_index"]):
-        end = float(ds.end_X[b]), float(ds.end_V[b])
+        end = float(ds["end_" + ca][b]), float(ds["end_" + cb][b])
         rows.append((BRANCH_NAMES[b], str(int((flag == b).sum())),
                      ds.attrs[f"status_{BRANCH_NAMES[b]}"],
                      f"({end[0]:+.5g}, {end[1]:+.5g})" if math.isfinite(end[0]) else "-"))
