@@ -99,7 +99,8 @@ def test_a_resumed_map_is_bit_identical_and_recomputes_nothing_finished(tmp_path
         ns.parameter_map(P3, store=store, chunk=13, **{**MAP, "y": ("F0", 0.25, 0.36, 5)})
 
 
-@pytest.mark.parametrize("analysis", ["bifurcation", "basins", "eta_study", "resonance"])
+@pytest.mark.parametrize("analysis", ["bifurcation", "basins", "eta_study", "resonance",
+                                      "attractor_continuation"])
 def test_every_sweep_resumes_bit_identically(analysis, tmp_path):
     calls = {
         "bifurcation": lambda **kw: ns.bifurcation_diagram(
@@ -113,6 +114,8 @@ def test_every_sweep_resumes_bit_identically(analysis, tmp_path):
                                                      np.linspace(0.6, 1.4, 60),
                                                      method="exact", transient=60, record=10,
                                                      **kw),
+        "attractor_continuation": lambda **kw: ns.attractor_continuation(
+            ns.preset("fig7"), "omega", [1.08, 1.12, 1.16], grid=12, method="exact", **kw),
     }
     ref = calls[analysis]()
     store = tmp_path / "s"

@@ -70,6 +70,18 @@ def match(prev, new, tol) -> dict:
     return out
 
 
+def _value_chunk(spec, i, carry, workers=None, progress=None):
+    """Chunk i of attractor_continuation: the basins at the i-th value (a Dataset, stored
+    pickled with every bit)."""
+    from ..chunks import solver_from_spec
+    from .basins import basins
+    m = solver_from_spec(spec["solver"]).model
+    params = m.params(**spec["params"]).replace(**{spec["param"]: float(spec["values"][i])})
+    return {"basins": basins(params, x=tuple(spec["x"]), v=tuple(spec["v"]), grid=spec["grid"],
+                             method=spec["method"], lyapunov=False, workers=workers,
+                             **spec["basins_kw"])}
+
+
 def _check_values(param, values) -> np.ndarray:
     vals = np.asarray(values, dtype=np.float64)
     if vals.ndim != 1 or vals.size < 2:
@@ -85,7 +97,8 @@ def _check_values(param, values) -> np.ndarray:
 
 def attractor_continuation(params, param: str, values, *, x=(-3.0, 3.0), v=(-3.0, 3.0),
                            grid=40, method: str = "smooth", match_tol: float | None = None,
-                           progress=None, **basins_kw) -> xr.Dataset:
+                           progress=None, store=None, engine=None, workers: int | None = None,
+                           **basins_kw) -> xr.Dataset:
     """The attractors at each of ``values`` of ``param`` (``basins`` on the window ``x`` x
     ``v`` with ``grid`` points per axis; further keywords such as ``transient``,
     ``max_periods``, ``rtol``, ``workers``, ``axes``, ``u0`` go to :func:`nonsmooth.basins`),
@@ -98,7 +111,11 @@ def attractor_continuation(params, param: str, values, *, x=(-3.0, 3.0), v=(-3.0
     ``section_X``/``section_V`` (param, attractor, n); per value ``undecided_fraction`` and
     ``n_attractors``; per attractor ``born`` and ``died`` (the first value where it exists
     after not existing, and where it no longer exists after existing; NaN: from the first
-    value on, or to the last)."""
+    value on, or to the last).
+
+    ``store`` / ``engine``: chunked, resumable runs (one chunk per value: its basins) and
+    where they run (``nonsmooth.chunks``; on Dask the values run side by side); ``workers``:
+    threads per value (None: all cores). The matching runs on the finished values."""
     from ..simulate import check_forced, check_params
     from ..sweep import progress_callback
     from .basins import basins
@@ -114,13 +131,21 @@ def attractor_continuation(params, param: str, values, *, x=(-3.0, 3.0), v=(-3.0
     if "lyapunov" in basins_kw:
         raise ParameterError("lyapunov: not an option here (each value's basins run without "
                              "the evidence; run basins at a value for it)")
+    for key in ("store", "engine"):
+        basins_kw.pop(key, None)
     progress = progress_callback(progress, "attractors")
-    runs = []
-    for i, w in enumerate(vals):
-        runs.append(basins(params.replace(**{p.name: float(w)}), x=x, v=v, grid=grid,
-                           method=method, lyapunov=False, **basins_kw))
-        if progress is not None:
-            progress(i + 1, len(vals))
+    from ..chunks import Plan, check_engine, execute, plan_solver
+    from ..kernels import Solver
+    engine = check_engine(engine)
+    spec = {"solver": plan_solver(Solver(method=method, model=params.model), engine),
+            "params": params.as_dict(), "param": p.name, "values": vals,
+            "x": [float(b) for b in x], "v": [float(b) for b in v], "grid": grid,
+            "method": method, "basins_kw": basins_kw}
+    plan = Plan("attractor_continuation", {k: val for k, val in spec.items() if k != "solver"}
+                | {"model": spec["solver"]["model"]}, len(vals), _value_chunk, spec)
+    runs = [None] * len(vals)
+    execute(plan, lambda i, res: runs.__setitem__(i, res["basins"]), store=store,
+            engine=engine, workers=workers, progress=progress)
     b0 = runs[0]
     diag = math.hypot(float(b0.x0[-1] - b0.x0[0]), float(b0.v0[-1] - b0.v0[0]))
     tol = 0.1 * diag if match_tol is None else float(match_tol)

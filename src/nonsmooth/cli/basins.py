@@ -119,12 +119,14 @@ def attractors_cmd(
     rtol: RtolOpt = 1e-8,
     atol: AtolOpt = 1e-10,
     workers: WorkersOpt = None,
+    dask: DaskOpt = None,
     out: OutOpt = None,
     plot: PlotOpt = None,
 ):
     """Attractors followed across a parameter: found at each value from a grid of initial
     conditions (as basins), matched value to value, with their basin shares, births and
-    deaths."""
+    deaths. With -o, finished values are kept in <out>.chunks until the result is written:
+    the same command resumes an interrupted run."""
     from ..analysis.attractor_continuation import attractor_continuation
     from ..sweep import Progress
     from .analyses import default_range, value_range
@@ -141,12 +143,14 @@ def attractors_cmd(
         params.replace(**{param: float(val)})
     require_output(out, plot)
     check_outputs(out, plot)
+    store, engine = chunk_store(out, dask)
     with Progress(f"attractors over {param}") as bar:
         ds = attractor_continuation(params, param, values, x=x, v=v, grid=grid, method=method,
                                     match_tol=match_tol, max_periods=max_periods, rtol=rtol,
-                                    atol=atol, workers=workers, progress=bar)
+                                    atol=atol, workers=workers, progress=bar, store=store,
+                                    engine=engine)
     from ..plot.attractor_continuation import plot_attractor_continuation
-    save_outputs(ds, preset, out, plot, plot_attractor_continuation)
+    save_outputs(ds, preset, out, plot, plot_attractor_continuation, store=store)
     na = ds.sizes["attractor"]
     typer.echo(f"{preset}: {param} {from_:g} ... {to:g}, {steps} values, {grid}x{grid} initial "
                f"conditions each: {na} attractor(s) along the path, at most "
