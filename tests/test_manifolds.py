@@ -167,6 +167,11 @@ def test_result_file_and_bad_input(fig7, tmp_path):
     xr.testing.assert_equal(got, ds)
     assert got.attrs["analysis"] == "manifolds" and got.attrs["method"] == "exact"
     assert got.branch.attrs["flag_meanings"].split()[0] == "unstable_plus"
+    seen = []
+    short = ns.manifolds(p, orbit, length=0.2, progress=lambda d, t: seen.append((d, t)))
+    assert short.sizes["point"] > 10 and seen[-1] == (4 * 4000, 4 * 4000)
+    assert all(0 <= d <= t for d, t in seen) and [d for d, _ in seen] == sorted(
+        d for d, _ in seen)
     stable = ns.periodic_orbit(p, x0=0.0, v0=0.0, transient=300)
     for call, field in [
         (lambda: ns.manifolds(p, stable), "orbit: a saddle"),

@@ -130,6 +130,16 @@ class _Map:
         self.plane = (0, 1)  # the section coordinates the stable search varies
         self.idx = None  # kernel state positions of the active section coordinates
         self.periods = 0  # forcing periods integrated (work done)
+        self.progress = None  # progress(done, total) in points, max_points per branch
+        self.done = 0
+        self.cap = 0  # the count at the end of the branch being grown
+        self.total = 0
+
+    def report(self, points: int):
+        """Count ``points`` more points of the branch being grown (progress)."""
+        self.done += points
+        if self.progress is not None:
+            self.progress(min(self.done, self.cap), self.total)
 
     def states(self, Z):
         return np.array([self.setup.state_of(z, self.template) for z in Z])
@@ -290,6 +300,7 @@ def _unstable_branch(mp: _Map, zs, e, lam, sign, delta, spacing, max_angle, leng
         pts.append(P[:keep])
         ts.append(j + S[:keep])
         count += keep
+        mp.report(keep)
         cum = total + np.r_[0.0, np.cumsum(seg)]
         if status == "integration failed":
             pts[-1], ts[-1] = P, j + S
@@ -412,6 +423,7 @@ def _stable_branch(mp: _Map, start, zs, e_s, Einv, sign, delta, spacing, max_ang
             status = "lost: no point of the boundary found within the smallest step"
             break
         W.append(found)
+        mp.report(1)
         total += float(np.linalg.norm(found - W[-2]))
         h = min(spacing, 1.5 * h)
         if total >= length:
@@ -517,7 +529,8 @@ def manifolds(params, orbit, *, x=None, v=None, spacing: float | None = None,
               delta: float | None = None, max_angle: float = 0.3, length: float | None = None,
               iterates: int | None = None, max_points: int = 4000, stable: bool = True,
               radius: float | None = None, max_search: int = 100,
-              tol: float | None = None, point: int = 0, axes=None) -> xr.Dataset:
+              tol: float | None = None, point: int = 0, axes=None,
+              progress=None) -> xr.Dataset:
     """The stable and unstable manifolds of the saddle ``orbit`` (a converged
     :func:`nonsmooth.periodic_orbit` of ``params``, same model and parameters; its method, k,
     tolerances and section phase are used) as polylines, by the methods of the module
@@ -544,7 +557,9 @@ def manifolds(params, orbit, *, x=None, v=None, spacing: float | None = None,
     multiplier is a hypersurface: what is grown is the curve where it meets the plane of
     ``axes`` through the saddle (the other coordinates held at the saddle's, as ``basins``
     with ``axes`` and ``u0`` = the saddle's point draws its boundary), and homoclinic points
-    are not sought there.
+    are not sought there. ``progress`` (None or False: silent; True: a progress bar; or a
+    callable ``progress(done, total)``): points grown, ``max_points`` per branch (a branch
+    that ends sooner counts as finished).
 
     Returns a Dataset over ``point`` (all branches one after the other): ``X``, ``V`` (and the
     further state components), ``branch`` (flag: unstable_plus, unstable_minus, stable_plus,
@@ -593,12 +608,22 @@ def manifolds(params, orbit, *, x=None, v=None, spacing: float | None = None,
     mp.lam = abs(lam)
     mp.plane = plane
     mp.idx = _state_positions(setup)[act]
+    from ..sweep import progress_callback
+    mp.progress = progress_callback(progress, "manifolds")
+    mp.total = (4 if stable else 2) * max_points
+    mp.cap = max_points
+
+    def branch_done(i):
+        mp.done = mp.cap = (i + 1) * max_points
+        mp.report(0)
+        mp.cap += max_points
     nshow = m.n
     branches, statuses, ends, levels = [], [], [], []
     for sign in (1.0, -1.0):
         P, T, status, end = _unstable_branch(mp, zs, e_u, lam, sign, delta, spacing, max_angle,
                                              length, iterates, max_points, nshow)
         branches.append(P[:, :nshow])
+        branch_done(len(branches) - 1)
         levels.append(T)
         statuses.append(status)
         ends.append(end[:nshow] if end is not None else np.full(nshow, np.nan))
@@ -624,6 +649,7 @@ def manifolds(params, orbit, *, x=None, v=None, spacing: float | None = None,
             full = np.repeat(zs[None, :nshow], len(W), axis=0)
             full[:, list(plane)] = W
             branches.append(full)
+            branch_done(len(branches) - 1)
             levels.append(np.full(len(W), np.nan))
             statuses.append(status)
             ends.append(np.full(nshow, np.nan))
@@ -786,7 +812,8 @@ def homoclinic_tangency(params, orbit, param: str, bounds, *, tol: float = 1e-4,
         raise ParameterError(f"bounds: expected two different finite values, got {bounds!r}")
     tol = _positive("tol", tol)
     import inspect
-    known = set(inspect.signature(manifolds).parameters) - {"params", "orbit", "stable"}
+    known = set(inspect.signature(manifolds).parameters) - {"params", "orbit", "stable",
+                                                             "progress"}
     for key in manifold_kw:
         if key not in known:
             raise ParameterError(f"{key}: not an option of manifolds here (known: "

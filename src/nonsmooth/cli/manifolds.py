@@ -76,8 +76,10 @@ def manifolds_cmd(
                    f"{v0:g}): {orbit.attrs['status']}; try another start (--x0, --v0, --u0)",
                    err=True)
         raise typer.Exit(EXIT_NOT_FOUND)
-    ds = manifolds(params, orbit, x=x, v=v, spacing=spacing, length=length, stable=stable,
-                   point=point, axes=axes)
+    from ..sweep import Progress
+    with Progress("manifolds") as bar:
+        ds = manifolds(params, orbit, x=x, v=v, spacing=spacing, length=length, stable=stable,
+                       point=point, axes=axes, progress=bar)
     bas = None
     if plot is not None and grid:
         from ..analysis.basins import basins
