@@ -189,3 +189,43 @@ def test_a_user_model_is_a_model():
     assert isinstance(m, Model) and isinstance(m.methods["exact"], Method)
     assert m is ns.model(EXAMPLE)  # NAME defaults to MODEL; loaded once
     assert m.source.endswith("one_sided_duffing.py:MODEL")
+
+
+def test_a_copied_folder_with_its_numba_cache_loads(tmp_path):
+    """numba's in-tree cache (``__pycache__`` beside the file, where NUMBA_CACHE_DIR is unset)
+    names the module it was compiled for, and user models were loaded under a name made of
+    their path: a folder copied with its cache failed with "No module named
+    nonsmooth_user_model_<old path>". A user file's numba functions are now cached under a
+    name made of its contents, in the package's cache. Fresh processes, as a user copying a
+    project would run them."""
+    import os
+    import shutil
+    import subprocess
+    import sys
+
+    from nonsmooth._numba_cache import cache_base
+    a, b = tmp_path / "a", tmp_path / "b"
+    a.mkdir()
+    shutil.copy(EXAMPLE, a / "one_sided_duffing.py")
+    # NUMBA_CACHE_DIR unset (numba's own choice would be __pycache__ beside the file); the
+    # package's cache then lies in XDG_CACHE_HOME/nonsmooth/numba: this run's, for speed
+    xdg = tmp_path / "xdg"
+    (xdg / "nonsmooth").mkdir(parents=True)
+    (xdg / "nonsmooth" / "numba").symlink_to(cache_base(), target_is_directory=True)
+    env = {k: v for k, v in os.environ.items() if k != "NUMBA_CACHE_DIR"}
+    env["XDG_CACHE_HOME"] = str(xdg)
+    code = ("import nonsmooth as ns; m = ns.model({!r}); "
+            "print(repr(float(ns.simulate(m.params(), periods=3, method='exact').X[-1])))")
+    outs = []
+    for folder in (a, b):
+        if folder is b:
+            shutil.copytree(a, b)  # with whatever cache lies beside the file
+        r = subprocess.run([sys.executable, "-c", code.format(
+            f"{folder / 'one_sided_duffing.py'}:MODEL")], env=env, capture_output=True,
+            text=True)
+        assert r.returncode == 0, r.stderr.strip().splitlines()[-1]
+        outs.append(r.stdout.strip())
+    assert outs[0] == outs[1] and float(outs[0]) == float(outs[0])
+    assert not list(tmp_path.rglob("one_sided_duffing*.nbi"))  # none beside the file
+    assert list((cache_base() / "user").glob("nonsmooth_user_model_one_sided_duffing_py_*/"
+                                             "one_sided_duffing*.nbi"))

@@ -100,22 +100,40 @@ def _subpath(py_file: Path) -> str:
         str(py_file.resolve().parent).encode()).hexdigest()[:12]
 
 
+#: Users' model files (resolved path -> the module name they are loaded under, which names
+#: their contents: ``models._load_user``): their numba functions are cached under that name.
+user_modules: dict = {}
+
+
+def register_user_file(path, modname: str) -> None:
+    """Cache the numba functions of the user's model file ``path`` (loaded as module
+    ``modname``, a name made of its file name and a digest of its contents) in
+    ``<cache>/user/<modname>``, not in ``__pycache__`` beside it: numba's cache names the module
+    it was compiled for, so a cache that travels with a copied or moved folder, or one written
+    under an older naming, would name a module that does not exist."""
+    user_modules[Path(path).resolve()] = modname
+
+
 def _locator_class():
     from numba.core import caching
 
     class KernelCacheLocator(caching._CacheLocator):
-        """Cache locator for this package's kernels (see module docstring)."""
+        """Cache locator for this package's kernels and the users' model files (see module
+        docstring and ``register_user_file``)."""
 
-        def __init__(self, py_func, py_file):
+        def __init__(self, py_func, py_file, user=None):
             self._py_file = py_file
             self._lineno = py_func.__code__.co_firstlineno
-            self._cache_path = str(cache_base() / _subpath(Path(py_file)))
+            self._user = user
+            self._cache_path = str(cache_base() / ("user/" + user if user else
+                                                   _subpath(Path(py_file))))
 
         def get_cache_path(self):
             return self._cache_path
 
         def get_source_stamp(self):
-            return "nonsmooth-kernels-" + source_digest()
+            return "nonsmooth-kernels-" + source_digest() + (f"-{self._user}" if self._user
+                                                             else "")
 
         def get_disambiguator(self):
             return str(self._lineno)
@@ -126,9 +144,10 @@ def _locator_class():
                 path = Path(py_file).resolve()
             except (OSError, TypeError):
                 return None
-            if cache_base() is None or path not in _kernel_set():
+            user = user_modules.get(path)
+            if cache_base() is None or (user is None and path not in _kernel_set()):
                 return None
-            self = cls(py_func, py_file)
+            self = cls(py_func, py_file, user)
             try:
                 self.ensure_cache_path()
             except OSError:

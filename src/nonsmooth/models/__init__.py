@@ -11,6 +11,7 @@ oscillator with a spring-damper support across a gap), ``two_sided``, ``impact``
 
 from __future__ import annotations
 
+import hashlib
 import importlib
 import importlib.util
 import os
@@ -62,7 +63,14 @@ def _load_user(path: str, attr: str) -> Model:
         return _USER[key]
     if not os.path.isfile(full):
         raise ParameterError(f"model: no such file {path!r}")
-    modname = "nonsmooth_user_model_" + "".join(ch if ch.isalnum() else "_" for ch in full)
+    # the module's name comes from the file's name and contents; its numba functions are
+    # cached under that name (``_numba_cache.register_user_file``), whatever folder it is in
+    with open(full, "rb") as fh:
+        digest = hashlib.sha1(fh.read()).hexdigest()[:16]
+    stem = "".join(ch if ch.isalnum() else "_" for ch in os.path.basename(full))
+    modname = f"nonsmooth_user_model_{stem}_{digest}"
+    from .._numba_cache import register_user_file
+    register_user_file(full, modname)
     spec = importlib.util.spec_from_file_location(modname, full)
     mod = importlib.util.module_from_spec(spec)
     sys.modules[modname] = mod
