@@ -290,6 +290,11 @@ def test_the_stable_manifold_of_a_four_dimensional_section_is_traced_in_a_plane(
         assert np.all(d4.Y.values[d4.branch.values == b] == 0.0)
     for b in (0, 1):  # the unstable branches too (4-D integration: its own steps)
         assert _near_polyline(_branch(d2, b), _branch(d4, b)[::10]) < 1e-4
+    yx = ns.manifolds(p4, o4, axes="V,X", x=(-1.5, 1.5), v=(-2, 2), length=3.0, spacing=0.05,
+                      max_search=60)  # the plane (V, X): the same curves
+    assert yx.attrs["axes"] == "V X" and yx.attrs["section_coordinates"] == 4
+    for b in (2, 3):
+        assert _near_polyline(_branch(d4, b), _branch(yx, b)) < 1e-5
     # (beyond |Y| = 0.88 its points leave the saddle before they reach its box: "lost")
     xy = ns.manifolds(p4, o4, axes="X,Y", x=(-2, 2), v=(-1, 1), length=0.6, spacing=0.05,
                       max_search=60)

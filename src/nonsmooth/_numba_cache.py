@@ -108,9 +108,9 @@ user_modules: dict = {}
 def register_user_file(path, modname: str) -> None:
     """Cache the numba functions of the user's model file ``path`` (loaded as module
     ``modname``, a name made of its file name and a digest of its contents) in
-    ``<cache>/user/<modname>``, not in ``__pycache__`` beside it: numba's cache names the module
-    it was compiled for, so a cache that travels with a copied or moved folder, or one written
-    under an older naming, would name a module that does not exist."""
+    ``<cache>/user/<modname>`` rather than in ``__pycache__`` beside it (where no cache
+    directory is writable, numba's own locators decide): numba's cache names the module it
+    was compiled for, and a cache beside the file travels with a copied folder."""
     user_modules[Path(path).resolve()] = modname
 
 

@@ -269,7 +269,7 @@ def component_names(state_names) -> list[str]:
 _RESULT_NAMES = frozenset(
     "X V t n i j mode region visited period status sample point special crossing attractor "
     "label kind count fraction stable contact converged multiplier component row col "
-    "eigenvalue equilibrium hopf".split())
+    "eigenvalue equilibrium hopf angle unstable level branch".split())
 
 
 def components(ds, prefix: str = "", suffix: str = ""):

@@ -101,7 +101,7 @@ def attractor_continuation(params, param: str, values, *, x=(-3.0, 3.0), v=(-3.0
                            **basins_kw) -> xr.Dataset:
     """The attractors at each of ``values`` of ``param`` (``basins`` on the window ``x`` x
     ``v`` with ``grid`` points per axis; further keywords such as ``transient``,
-    ``max_periods``, ``rtol``, ``workers``, ``axes``, ``u0`` go to :func:`nonsmooth.basins`),
+    ``max_periods``, ``rtol``, ``axes``, ``u0`` go to :func:`nonsmooth.basins`),
     matched from value to value (see the module documentation; ``match_tol``: the largest
     distance of two section sets taken as one attractor).
 
@@ -131,8 +131,6 @@ def attractor_continuation(params, param: str, values, *, x=(-3.0, 3.0), v=(-3.0
     if "lyapunov" in basins_kw:
         raise ParameterError("lyapunov: not an option here (each value's basins run without "
                              "the evidence; run basins at a value for it)")
-    for key in ("store", "engine"):
-        basins_kw.pop(key, None)
     progress = progress_callback(progress, "attractors")
     from ..chunks import Plan, check_engine, execute, plan_solver
     from ..kernels import Solver

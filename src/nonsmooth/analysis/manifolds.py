@@ -4,8 +4,8 @@ homoclinic crossings (issue 21, item 2).
 ``manifolds(params, orbit) -> xarray.Dataset``
 
 ``orbit`` is a converged :func:`nonsmooth.periodic_orbit` of the k-fold map P^k with one
-multiplier outside the unit circle (mu_u, eigenvector e_u) and, for the stable manifold, a
-two-dimensional section (mu_s, e_s). Where mu_u < 0 the map used is P^2k, so that each branch
+multiplier outside the unit circle (mu_u, eigenvector e_u; in a two-dimensional section the
+other is mu_s, eigenvector e_s). Where mu_u < 0 the map used is P^2k, so that each branch
 is invariant on its own (lambda = mu_u^2); otherwise P^k (lambda = mu_u). Each manifold has two
 branches, leaving the saddle z* on either side of its eigenvector.
 
@@ -74,13 +74,15 @@ BRANCH_NAMES = ("unstable_plus", "unstable_minus", "stable_plus", "stable_minus"
 def _exit_sides(method, fns, p, opts, states, q, idx, zs, Einv, r, r_lo, max_iter, side, used):
     """For each state (at a period boundary): the side (+1 / -1, the sign of c_u) on which its
     orbit under the q-period map leaves the saddle zs after having entered its box
-    |c_i| < r ((c_0 = c_u, c_1, ...) = Einv (z - zs), z the section coordinates at the kernel
-    state positions idx): where |c_u| >= r, or already where |c_u| >= r_lo >= max |c_i>0|
+    |c_u| < r, |c_s| < r ((c_u, c_1, c_2, ...) = Einv (z - zs), row 0 of Einv giving c_u;
+    |c_s| the Euclidean norm of the others; z the section coordinates at the kernel state
+    positions idx): where |c_u| >= r, or already where |c_u| >= r_lo >= |c_s|
     (r_lo = r / (2 lambda): a strongly expanding saddle carries a point from inside the box
     far beyond it in one map; there the local stable manifold, c_u = O(|c_s|^2), is far below
     r_lo). 0 if it does not within max_iter maps or its integration fails. used[i]: the maps
     it took."""
     m = idx.shape[0]
+    rows = Einv.shape[0]
     for i in nb.prange(states.shape[0]):
         ox, ov, orr, om, oxa, oxi = _one_interval()
         entered = False
@@ -93,9 +95,9 @@ def _exit_sides(method, fns, p, opts, states, q, idx, zs, Einv, r, r_lo, max_ite
                 if s != 0:
                     break
             cu = 0.0
-            cs = 0.0  # the largest |c| of the other coordinates
+            cs2 = 0.0  # the Euclidean norm of the other coordinates, squared
             finite = True
-            for a in range(m):
+            for a in range(rows):
                 c = 0.0
                 for b in range(m):
                     c += Einv[a, b] * (states[i, idx[b]] - zs[b])
@@ -104,9 +106,10 @@ def _exit_sides(method, fns, p, opts, states, q, idx, zs, Einv, r, r_lo, max_ite
                 if a == 0:
                     cu = c
                 else:
-                    cs = max(cs, abs(c))
+                    cs2 += c * c
             if not finite:
                 break
+            cs = math.sqrt(cs2)  # (|c_s| itself for one stable coordinate)
             if abs(cu) < r and cs < r:
                 entered = True
             if entered and (abs(cu) >= r or (abs(cu) >= r_lo and cs <= r_lo)):
@@ -536,7 +539,8 @@ def manifolds(params, orbit, *, x=None, v=None, spacing: float | None = None,
     tolerances and section phase are used) as polylines, by the methods of the module
     documentation; their homoclinic crossings.
 
-    ``x``, ``v``: the window (X and V ranges) the branches are grown in (default: none, then
+    ``x``, ``v``: the window (the ranges of the two ``axes``, default X and V) the branches
+    are grown in (default: none, then
     ``length`` bounds them); ``spacing``: the largest distance between consecutive points,
     to a few per cent (default: 1/200 of the window's diagonal, else 0.01 (1 + ‖z*‖)); ``delta``: the distance
     of the first point from the saddle (default spacing / 1000); ``max_angle``: the largest
@@ -551,14 +555,16 @@ def manifolds(params, orbit, *, x=None, v=None, spacing: float | None = None,
     the curve (default spacing / 10^4); ``point``: which of a period-k saddle's k section
     points the manifolds belong to (default 0; the orbit is re-centred there by Newton
     shooting, its monodromy taken there: the manifolds of point j are those of P^k at z_j);
-    ``axes``: the two state components of the window and of the stable search (default the
-    first two; e.g. ("X", "Y") or "X,Y"). Where the section has more than two coordinates
-    (n > 2, or an active memory slot) the stable manifold of a saddle with one unstable
-    multiplier is a hypersurface: what is grown is the curve where it meets the plane of
-    ``axes`` through the saddle (the other coordinates held at the saddle's, as ``basins``
-    with ``axes`` and ``u0`` = the saddle's point draws its boundary), and homoclinic points
-    are not sought there. ``progress`` (None or False: silent; True: a progress bar; or a
-    callable ``progress(done, total)``): points grown, ``max_points`` per branch (a branch
+    ``axes``: the two state components of the window and of the stable search, by the
+    model's state names (default the first two; e.g. ("X", "Y") or "X,Y"; the result's attr
+    ``axes`` names them as its variables are named, X and V for the first two). Where the
+    section has more than two coordinates (n > 2, or a memory slot the map depends on) the
+    stable manifold of a saddle with one unstable multiplier is a hypersurface: what is grown
+    is the curve where it meets the plane of ``axes`` through the saddle (the other
+    coordinates held at the saddle's: for n > 2 without memory, the boundary that ``basins``
+    with ``axes`` and ``u0`` = the saddle's point draws), and homoclinic points are not
+    sought there (attr ``section_coordinates``). ``progress`` (None or False: silent; True:
+    a progress bar; or a callable ``progress(done, total)``): points grown, ``max_points`` per branch (a branch
     that ends sooner counts as finished).
 
     Returns a Dataset over ``point`` (all branches one after the other): ``X``, ``V`` (and the
@@ -632,7 +638,8 @@ def manifolds(params, orbit, *, x=None, v=None, spacing: float | None = None,
     cross = []
     if stable:
         za = zs[act]
-        Einv, e_s = _stable_coordinates(E, mu, iu, e_u[act], act, plane, planar)
+        M = np.asarray(orbit.monodromy.values, dtype=float)[np.ix_(act, act)]
+        Einv, e_s = _stable_coordinates(E, mu, iu, e_u[act], act, plane, planar, M)
         stable_method = ("search: each point bisected across the curve between initial "
                          "conditions that leave the saddle along opposite unstable branches "
                          "(no inverse map)")
@@ -669,7 +676,7 @@ def manifolds(params, orbit, *, x=None, v=None, spacing: float | None = None,
                         spacing=spacing, delta=delta, max_angle=max_angle, length=length,
                         iterates=iterates, max_points=max_points, radius=radius,
                         max_search=max_search, tol=tol, periods_integrated=mp.periods,
-                        orbit_point=int(point)))
+                        orbit_point=int(point), section_coordinates=int(act.sum())))
 
 
 def _state_positions(setup: TangentSetup):
@@ -681,34 +688,37 @@ def _state_positions(setup: TangentSetup):
     return np.asarray(pos, np.int64)
 
 
-def _stable_coordinates(E, mu, iu, e_u, act, plane, planar):
-    """(Einv, e_s): the inverse of the real eigenbasis of the active coordinates (row 0 the
-    unstable coordinate c_u, the others spanning the stable subspace; a complex pair by its
-    real and imaginary parts) and the stable direction in the plane: the stable eigenvector
-    for a planar section, else the line where the plane meets the stable subspace (c_u = 0)."""
-    cols = [e_u]
-    seen = set()
-    for i in range(len(mu)):
-        if i == iu or i in seen:
-            continue
-        v = E[:, i]
-        if abs(mu[i].imag) > 0.0:
-            if planar:
-                raise ParameterError("orbit: complex stable multipliers")
-            j = next((j for j in range(len(mu)) if j != i and j not in seen and
-                      abs(mu[j] - np.conj(mu[i])) <= 1e-12 * abs(mu[i])), None)
-            if j is not None:
-                seen.add(j)
-            cols += [v.real / np.linalg.norm(v.real), v.imag / np.linalg.norm(v.imag)]
-        else:
-            cols.append(v.real / np.linalg.norm(v.real))
-    Einv = np.linalg.inv(np.column_stack(cols[:len(mu)]))
+def _stable_coordinates(E, mu, iu, e_u, act, plane, planar, M):
+    """(Einv, e_s): the rows that give the classifier's coordinates of z - z* (row 0: the
+    unstable coordinate c_u; the others: the stable part) and the stable direction in the
+    plane.
+
+    A planar section: the inverse of the eigenbasis (e_u, e_s), and e_s. More coordinates: c_u
+    from the left eigenvector l_u of mu_u (l_u e_u = 1; ``M`` the active monodromy) and the
+    stable part as the components of z - z* - c_u e_u (no inverse of the whole eigenbasis,
+    which repeated or defective stable multipliers, e.g. zeros from sticking, make singular);
+    the direction: the line where the plane meets c_u = 0."""
     at = np.flatnonzero(act)
     pa, pb = (int(np.flatnonzero(at == c)[0]) for c in plane)
     if planar:
-        return Einv, cols[1][[pa, pb]]
-    lu = Einv[0]
-    d = np.array([-lu[pb], lu[pa]])
+        i_s = 1 - iu
+        if abs(mu[i_s].imag) > 0.0:
+            raise ParameterError("orbit: complex stable multipliers")
+        e_s = E[:, i_s].real / np.linalg.norm(E[:, i_s].real)
+        Einv = np.linalg.inv(np.column_stack([e_u, e_s]))
+        return Einv, np.array([e_s[pa], e_s[pb]])
+    lam, L = np.linalg.eig(M.T)
+    j = int(np.argmin(np.abs(lam - mu[iu])))
+    lu = L[:, j].real
+    scale = float(lu @ e_u)
+    if not abs(scale) > 1e-12 * np.linalg.norm(lu):
+        raise ParameterError("orbit: the unstable multiplier's left and right eigenvectors are "
+                             "orthogonal (a defective multiplier); no stable manifold here")
+    lu = lu / scale
+    Einv = np.vstack([lu[None, :], np.eye(len(e_u)) - np.outer(e_u, lu)])
+    lo, hi = sorted((pa, pb))  # the same branch "plus" whichever order the axes are given
+    along = {lo: -lu[hi], hi: lu[lo]}
+    d = np.array([along[pa], along[pb]])
     if not np.linalg.norm(d) > 1e-9 * np.linalg.norm(lu):
         raise ParameterError("axes: the plane lies in the saddle's stable subspace (no curve "
                              "to trace there); choose other axes")
@@ -760,8 +770,7 @@ def _dataset(params, solver, k, q, zs, mu, e_u, e_s, branches, levels, statuses,
                 "long_name": "the unstable branch", "flag_values": np.arange(nb_, dtype=np.int8),
                 "flag_meanings": " ".join(names)}),
             "crossing_stable": ("crossing", np.array([c[3] for c in cross], np.int8), {
-                "long_name": "the stable branch (-1: the stable manifold, a section of more "
-                             "than two coordinates)", "flag_values": np.arange(nb_, dtype=np.int8),
+                "long_name": "the stable branch", "flag_values": np.arange(nb_, dtype=np.int8),
                 "flag_meanings": " ".join(names)}),
         },
         coords={"point": np.arange(len(U)), "branch_index": ("branch_index", np.arange(nb_), {
@@ -851,6 +860,11 @@ def homoclinic_tangency(params, orbit, param: str, bounds, *, tol: float = 1e-4,
     def crossings(value):
         pv, got = saddle(value)
         ds = manifolds(pv, got, **manifold_kw)
+        if ds.attrs["section_coordinates"] != 2:
+            raise ParameterError(f"{name}: at {name} = {value:g} the section has "
+                                 f"{ds.attrs['section_coordinates']} coordinates (a memory "
+                                 f"slot the map depends on): homoclinic points are sought "
+                                 f"in two")
         evals.append((value, int(ds.sizes["crossing"])))
         short = [b for b in BRANCH_NAMES[:2] if ds.attrs[f"status_{b}"].startswith(
             ("iterates", "max_points", "integration failed"))]

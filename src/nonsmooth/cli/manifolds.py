@@ -29,9 +29,9 @@ def manifolds_cmd(
     v0: V0Opt = 0.25,
     u0: U0Opt = None,
     x: Annotated[tuple[float, float], typer.Option(
-        "--x", help="window of X the branches are grown in: MIN MAX")] = (-3.0, 3.0),
+        "--x", help="window of X (of the first of --axes) the branches are grown in: MIN MAX")] = (-3.0, 3.0),
     v: Annotated[tuple[float, float], typer.Option(
-        "--v", help="window of V: MIN MAX")] = (-3.0, 3.0),
+        "--v", help="window of V (of the second of --axes): MIN MAX")] = (-3.0, 3.0),
     spacing: Annotated[Optional[float], typer.Option(
         "--spacing", help="largest distance between consecutive points (default: 1/200 of "
                           "the window's diagonal)")] = None,
