@@ -24,7 +24,7 @@ import pytest
 
 import nonsmooth as ns
 from nonsmooth.explore import compute
-from nonsmooth.explore.page import export_text, slice_range, slider_range
+from nonsmooth.explore.page import export_text, slice_range, slider_range, slider_scale
 
 LIMIT = 300.0  # safety limit of every wait (s): never reached when things work
 CHROMIUM = shutil.which("chromium") or shutil.which("chromium-browser")
@@ -51,6 +51,11 @@ def test_slider_and_slice_ranges_are_allowed_by_the_model():
         assert lo <= v <= hi or name == "eta"   # eta: the field sets what the slider can't
         prm.check(lo), prm.check(hi)      # open ends moved in: both ends allowed
     assert slider_range(m.param("eta"), 1e-5) == (0.5 / 400, 0.5 - 0.5 / 400)
+    # ... so eta's slider moves in log10 (a decade below the value up to the range's end)
+    lo, hi, log = slider_scale(m.param("eta"), 2.5e-6)
+    assert log and lo == pytest.approx(math.log10(2.5e-7)) and 10 ** hi == pytest.approx(
+        0.5 - 0.5 / 400)
+    assert slider_scale(m.param("omega"), 0.91)[2] is False
     # the slice's default range passes the cross-field rules too: support needs xi_s = 0
     # where omega_s = 0, stick_slip mu_s >= mu_k
     values = ns.preset("table3").as_dict()
@@ -311,6 +316,8 @@ def test_the_page_loads_and_shows_the_orbit(page):
     assert len(page.data("time_source", "t")) > 100
     assert sorted(page.prop("method", "options")) == ["exact", "smooth", "smooth_eq12"]
     assert "Γ" in page.prop("modes", "text") or "Gamma" in page.prop("modes", "text")
+    eta = float(page.prop("param_eta", "value"))  # a log slider: eta spans decades
+    assert page.prop("slider_eta", "value") == pytest.approx(math.log10(eta))
 
 
 @needs_browser

@@ -47,6 +47,16 @@ def slider_range(prm, value: float) -> tuple[float, float]:
     return float(lo), float(hi)
 
 
+def slider_scale(prm, value: float) -> tuple[float, float, bool]:
+    """(start, end, log) of a parameter's slider: ``slider_range``, or, for a positive value
+    below that range's start (a parameter that spans decades, e.g. the band eta = 2.5e-6 of
+    0 < eta < 0.5), a slider in log10 from a decade below the value to the range's end."""
+    lo, hi = slider_range(prm, value)
+    if value > 0 and hi > 0 and value < lo:
+        return math.log10(value) - 1.0, math.log10(hi), True
+    return lo, hi, False
+
+
 def slice_range(model, values: dict, name: str) -> tuple[float, float]:
     """The default range of the orbit-diagram slice over ``name``: +-20 % around its value
     (the slider's range for a value of 0), narrowed until both ends pass the model's checks
@@ -264,12 +274,16 @@ class Explorer:
         from bokeh.layouts import row
         from bokeh.models import Slider, TextInput
 
-        self.fields, self.sliders = {}, {}
+        self.fields, self.sliders, self.log_sliders = {}, {}, set()
         rows = []
         for prm in self.model.parameters:
             v = self.values[prm.name]
-            lo, hi = slider_range(prm, v)
-            field = TextInput(title=_label(prm), value=_fmt(v), name=f"param_{prm.name}", width=120)
+            lo, hi, log = slider_scale(prm, v)
+            if log:
+                self.log_sliders.add(prm.name)
+                v = math.log10(v)
+            field = TextInput(title=_label(prm), value=_fmt(self.values[prm.name]),
+                              name=f"param_{prm.name}", width=120)
             slider = Slider(start=lo, end=hi, value=min(max(v, lo), hi),
                             step=(hi - lo) / SLIDER_STEPS, title="", show_value=False,
                             name=f"slider_{prm.name}", width=200)
@@ -334,7 +348,8 @@ class Explorer:
         self.set_param(prm.name, v, from_field=True)
 
     def _on_slider(self, prm, attr, old, new):
-        self.fields[prm.name].value = _fmt(float(new))    # validated by the field
+        v = 10.0 ** float(new) if prm.name in self.log_sliders else float(new)
+        self.fields[prm.name].value = _fmt(v)    # validated by the field
 
     def _on_u0(self, i, attr, old, new):
         w = self.u0_fields[i]
@@ -385,10 +400,12 @@ class Explorer:
         if not from_field:
             self.fields[name].value = _fmt(value)
         s = self.sliders[name]
-        if not s.start <= value <= s.end:
-            lo, hi = min(s.start, value), max(s.end, value)
-            s.update(start=lo, end=hi, step=(hi - lo) / SLIDER_STEPS)
-        s.value = value
+        x = value if name not in self.log_sliders else math.log10(value) if value > 0 else None
+        if x is not None:
+            if not s.start <= x <= s.end:
+                lo, hi = min(s.start, x), max(s.end, x)
+                s.update(start=lo, end=hi, step=(hi - lo) / SLIDER_STEPS)
+            s.value = x
         if name == self.slice_param.value:
             self.slice_marker.location = value
         self.request_view()
