@@ -231,3 +231,22 @@ def test_signals_during_a_compiled_call_are_delivered_after_it():
         assert sg.getsignal(sg.SIGINT) is sg.default_int_handler
     finally:
         sg.signal(sg.SIGINT, before)
+
+
+def test_a_store_of_another_version_of_a_model_file_is_refused(tmp_path):
+    """A sweep's chunks computed with a user's model file are not reused once the file has
+    changed (its contents are part of the run's fingerprint; before, only its path was)."""
+    from pathlib import Path
+    src = Path(__file__).resolve().parents[1] / "examples" / "one_sided_duffing.py"
+    path = tmp_path / "model.py"
+    path.write_text(src.read_text())
+    m = ns.model(f"{path}:MODEL")
+    run = lambda: ns.bifurcation_diagram(m.params(), "omega", [0.9, 1.0, 1.1], method="exact",  # noqa: E731
+                                         transient=5, record=5, lyapunov=False,
+                                         store=tmp_path / "s")
+    first = run()
+    again = run()  # the same file: every chunk read back
+    _equal(first, again)
+    path.write_text(src.read_text() + "\n# edited\n")
+    with pytest.raises(ParameterError, match=r"different run.*model_digest"):
+        run()

@@ -529,9 +529,25 @@ def solver_spec(solver) -> dict:
     model defined only in this process (not built in, not loaded from a file) cannot travel."""
     m = solver.model
     ref = m.name if m.source == "built-in" else m.source
-    return {"model": ref, "method": solver.method, "rtol": solver.rtol, "atol": solver.atol,
-            "max_steps": solver.max_steps, "section_phase": solver.section_phase,
-            "defined_in_process": m.source == "built-in" and _not_builtin(m)}
+    out = {"model": ref, "method": solver.method, "rtol": solver.rtol, "atol": solver.atol,
+           "max_steps": solver.max_steps, "section_phase": solver.section_phase,
+           "defined_in_process": m.source == "built-in" and _not_builtin(m)}
+    digest = _file_digest(ref) if m.source != "built-in" else None
+    if digest is not None:  # a model from a file: a store of another version of it is refused
+        out["model_digest"] = digest
+    return out
+
+
+def _file_digest(source: str) -> str | None:
+    """sha1 (16 hex digits) of the contents of a model's file (``path.py:NAME``), or None."""
+    import hashlib
+    path = source.rpartition(":")[0] if source.count(":") and not source.endswith(".py") \
+        else source
+    try:
+        with open(path, "rb") as fh:
+            return hashlib.sha1(fh.read()).hexdigest()[:16]
+    except OSError:
+        return None
 
 
 def _not_builtin(m) -> bool:
@@ -557,6 +573,10 @@ def solver_from_spec(spec: dict):
                                  f"only; Dask workers need it in a file (path/to/file.py:NAME)")
     else:
         m = get_model(spec["model"])
+        digest = spec.get("model_digest")
+        if digest is not None and _file_digest(spec["model"]) != digest:
+            raise ParameterError(f"model: {spec['model']} here is not the file the run started "
+                                 f"with (its contents differ)")
     return Solver(model=m, method=spec["method"], rtol=spec["rtol"], atol=spec["atol"],
                   max_steps=spec["max_steps"], section_phase=spec.get("section_phase", 0.0))
 

@@ -139,8 +139,7 @@ def attractor_continuation(params, param: str, values, *, x=(-3.0, 3.0), v=(-3.0
             "params": params.as_dict(), "param": p.name, "values": vals,
             "x": [float(b) for b in x], "v": [float(b) for b in v], "grid": grid,
             "method": method, "basins_kw": basins_kw}
-    plan = Plan("attractor_continuation", {k: val for k, val in spec.items() if k != "solver"}
-                | {"model": spec["solver"]["model"]}, len(vals), _value_chunk, spec)
+    plan = Plan("attractor_continuation", spec, len(vals), _value_chunk, spec)
     runs = [None] * len(vals)
     execute(plan, lambda i, res: runs.__setitem__(i, res["basins"]), store=store,
             engine=engine, workers=workers, progress=progress)
