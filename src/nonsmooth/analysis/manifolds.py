@@ -795,7 +795,7 @@ def _dataset(params, solver, k, q, zs, mu, e_u, e_s, branches, levels, statuses,
 
 # ---- the first homoclinic tangency along a parameter -------------------------------------------
 def homoclinic_tangency(params, orbit, param: str, bounds, *, tol: float = 1e-4,
-                        **manifold_kw) -> xr.Dataset:
+                        progress=None, **manifold_kw) -> xr.Dataset:
     """The first homoclinic tangency of the saddle ``orbit`` (a converged
     :func:`nonsmooth.periodic_orbit` of ``params``) along ``param`` in ``bounds`` = (a, b):
     the value where its stable and unstable manifolds (as :func:`manifolds` computes them with
@@ -809,7 +809,10 @@ def homoclinic_tangency(params, orbit, param: str, bounds, *, tol: float = 1e-4,
     and ``<param>_above`` (the bracket: without and with crossings), over ``evaluation`` the
     values tried with their crossing counts (``value``, ``n_crossings``), and the manifolds
     at the bracket's upper end as ``crossing_X``, ``crossing_V``, ``crossing_angle``; attrs
-    ``status``. A one-line ParameterError where ``a`` already has crossings or ``b`` none."""
+    ``status``. A one-line ParameterError where ``a`` already has crossings or ``b`` none.
+    ``progress`` (None or False: silent; True: a progress bar; or a callable
+    ``progress(done, total)``): manifold computations done, of the two ends and the
+    bisection's steps."""
     from .stability import periodic_orbit
     params = check_params(params)
     name = params.model.param(param).name
@@ -874,15 +877,25 @@ def homoclinic_tangency(params, orbit, param: str, bounds, *, tol: float = 1e-4,
                                  f"more iterates or max_points")
         return ds
 
-    lo_ds = crossings(a)
+    from ..sweep import progress_callback
+    progress = progress_callback(progress, "homoclinic tangency")
+    steps = 2 + max(0, math.ceil(math.log2(abs(b - a) / tol)))
+
+    def crossings_counted(value):
+        ds = crossings(value)
+        if progress is not None:
+            progress(len(evals), steps)
+        return ds
+
+    lo_ds = crossings_counted(a)
     if lo_ds.sizes["crossing"]:
         raise ParameterError(f"bounds: the manifolds already cross at {name} = {a:g}")
-    hi_ds = crossings(b)
+    hi_ds = crossings_counted(b)
     if not hi_ds.sizes["crossing"]:
         raise ParameterError(f"bounds: the manifolds do not cross at {name} = {b:g}")
     while abs(b - a) > tol:
         mid = 0.5 * (a + b)
-        ds = crossings(mid)
+        ds = crossings_counted(mid)
         if ds.sizes["crossing"]:
             b, hi_ds = mid, ds
         else:
