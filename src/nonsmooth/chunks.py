@@ -532,22 +532,11 @@ def solver_spec(solver) -> dict:
     out = {"model": ref, "method": solver.method, "rtol": solver.rtol, "atol": solver.atol,
            "max_steps": solver.max_steps, "section_phase": solver.section_phase,
            "defined_in_process": m.source == "built-in" and _not_builtin(m)}
-    digest = _file_digest(ref) if m.source != "built-in" else None
+    from .models import file_digest
+    digest = file_digest(ref) if m.source != "built-in" else None
     if digest is not None:  # a model from a file: a store of another version of it is refused
         out["model_digest"] = digest
     return out
-
-
-def _file_digest(source: str) -> str | None:
-    """sha1 (16 hex digits) of the contents of a model's file (``path.py:NAME``), or None."""
-    import hashlib
-    path = source.rpartition(":")[0] if source.count(":") and not source.endswith(".py") \
-        else source
-    try:
-        with open(path, "rb") as fh:
-            return hashlib.sha1(fh.read()).hexdigest()[:16]
-    except OSError:
-        return None
 
 
 def _not_builtin(m) -> bool:
@@ -572,9 +561,10 @@ def solver_from_spec(spec: dict):
             raise ParameterError(f"model: {spec['model']!r} is defined in the client process "
                                  f"only; Dask workers need it in a file (path/to/file.py:NAME)")
     else:
+        from .models import file_digest
         m = get_model(spec["model"])
         digest = spec.get("model_digest")
-        if digest is not None and _file_digest(spec["model"]) != digest:
+        if digest is not None and file_digest(spec["model"]) != digest:
             raise ParameterError(f"model: {spec['model']} here is not the file the run started "
                                  f"with (its contents differ)")
     return Solver(model=m, method=spec["method"], rtol=spec["rtol"], atol=spec["atol"],

@@ -130,19 +130,33 @@ class _Map:
                       if window else math.inf)
         self.lam = 1.0  # the unstable multiplier of the q-period map
         self.zfill = None  # the saddle's section point (components the stable search fixes)
-        self.plane = (0, 1)  # the section coordinates the stable search varies
+        self.plane = [0, 1]  # the section coordinates the stable search varies
         self.idx = None  # kernel state positions of the active section coordinates
         self.periods = 0  # forcing periods integrated (work done)
-        self.progress = None  # progress(done, total) in points, max_points per branch
-        self.done = 0
-        self.cap = 0  # the count at the end of the branch being grown
+        self.progress = None  # progress(done, total) in points, ``per_branch`` a branch
+        self.per_branch = 0
         self.total = 0
+        self.base = 0  # the count at the start of the branch being grown
+        self.count = 0  # its points so far
 
     def report(self, points: int):
         """Count ``points`` more points of the branch being grown (progress)."""
-        self.done += points
+        self.count += points
         if self.progress is not None:
-            self.progress(min(self.done, self.cap), self.total)
+            self.progress(self.base + min(self.count, self.per_branch), self.total)
+
+    def next_branch(self):
+        """The branch being grown is finished (however many points it has)."""
+        self.base += self.per_branch
+        self.count = 0
+        self.report(0)
+
+    def embed(self, Z):
+        """Section points (rows z) from rows Z in the plane's two coordinates, the further
+        coordinates the saddle's (``self.zfill``)."""
+        full = np.repeat(self.zfill[None, :], len(Z), axis=0)
+        full[:, self.plane] = Z
+        return full
 
     def states(self, Z):
         return np.array([self.setup.state_of(z, self.template) for z in Z])
@@ -166,10 +180,8 @@ class _Map:
 
     def sides(self, Z, zs, Einv, r, max_iter):
         """Exit sides (see _exit_sides) of the points Z: rows in the plane's two coordinates
-        (``self.plane``), the further section coordinates the saddle's (``self.zfill``)."""
-        full = np.repeat(self.zfill[None, :], len(Z), axis=0)
-        full[:, list(self.plane)] = Z
-        return self.sides_full(full, zs, Einv, r, max_iter)
+        (``embed``)."""
+        return self.sides_full(self.embed(Z), zs, Einv, r, max_iter)
 
     def sides_full(self, Z, zs, Einv, r, max_iter):
         """Exit sides of the section points Z (rows z): zs and Einv on the active
@@ -280,7 +292,7 @@ def _unstable_branch(mp: _Map, zs, e, lam, sign, delta, spacing, max_angle, leng
             mark = (d > spacing) | (sharp & (d > fine))
             # both ends beyond the window by more than the chord: the curve between cannot
             # reach the window (for a chord of bounded curvature) and is not refined
-            Qp = Q[:, list(mp.plane)]
+            Qp = Q[:, mp.plane]
             out = (_outside(Qp, mp.window, np.r_[d, 0.0])
                    & _outside(Qp, mp.window, np.r_[0.0, d]))
             mark &= ~(out[:-1] & out[1:])
@@ -320,8 +332,7 @@ def _unstable_branch(mp: _Map, zs, e, lam, sign, delta, spacing, max_angle, leng
             end = P[-1]
             status = "converged onto an attractor"
             break
-        if mp.window is not None and np.all(_outside(Q[:, list(mp.plane)], mp.window,
-                                                     mp.reach)):
+        if mp.window is not None and np.all(_outside(Q[:, mp.plane], mp.window, mp.reach)):
             # beyond the window by more than half its size (nearer, later levels may come
             # back into it and are followed, unrefined outside it)
             pts[-1], ts[-1] = P, j + S
@@ -564,8 +575,8 @@ def manifolds(params, orbit, *, x=None, v=None, spacing: float | None = None,
     coordinates held at the saddle's: for n > 2 without memory, the boundary that ``basins``
     with ``axes`` and ``u0`` = the saddle's point draws), and homoclinic points are not
     sought there (attr ``section_coordinates``). ``progress`` (None or False: silent; True:
-    a progress bar; or a callable ``progress(done, total)``): points grown, ``max_points`` per branch (a branch
-    that ends sooner counts as finished).
+    a progress bar; or a callable ``progress(done, total)``): points grown, ``max_points``
+    per branch (a branch that ends sooner counts as finished).
 
     Returns a Dataset over ``point`` (all branches one after the other): ``X``, ``V`` (and the
     further state components), ``branch`` (flag: unstable_plus, unstable_minus, stable_plus,
@@ -582,13 +593,13 @@ def manifolds(params, orbit, *, x=None, v=None, spacing: float | None = None,
         raise ParameterError(f"manifolds: model {m.name} declares no forcing; the manifolds "
                              f"here are those of the stroboscopic map")
     window = _check_window(x, v)
-    plane = _check_axes(m, axes, None)[:2]
+    plane = list(_check_axes(m, axes, None)[:2])
     orbit = _centred(params, orbit, point)
     solver, setup, k, p, zs, act, mu, E = _saddle(params, orbit)
     diag = (math.hypot(window[0][1] - window[0][0], window[1][1] - window[1][0])
             if window else None)
     spacing = (_positive("spacing", spacing) if spacing is not None
-               else diag / 200.0 if diag else 0.01 * (1.0 + float(np.linalg.norm(zs[list(plane)]))))
+               else diag / 200.0 if diag else 0.01 * (1.0 + float(np.linalg.norm(zs[plane]))))
     delta = _positive("delta", delta) if delta is not None else spacing / 1000.0
     max_angle = _positive("max_angle", max_angle)
     length = (_positive("length", length) if length is not None
@@ -605,7 +616,7 @@ def manifolds(params, orbit, *, x=None, v=None, spacing: float | None = None,
     N = setup.N
     e_u = np.zeros(N)
     e_u[act] = E[:, iu].real / np.linalg.norm(E[:, iu].real)
-    planar = int(act.sum()) == 2  # the section is the plane (X, V) itself
+    planar = int(act.sum()) == 2  # the section is the plane itself
     if iterates is None:  # enough levels to carry the fundamental domain across the window
         iterates = 100 + int(math.ceil(math.log(max(length, 10 * spacing) / delta)
                                        / math.log(abs(lam))))
@@ -616,20 +627,15 @@ def manifolds(params, orbit, *, x=None, v=None, spacing: float | None = None,
     mp.idx = _state_positions(setup)[act]
     from ..sweep import progress_callback
     mp.progress = progress_callback(progress, "manifolds")
+    mp.per_branch = max_points
     mp.total = (4 if stable else 2) * max_points
-    mp.cap = max_points
-
-    def branch_done(i):
-        mp.done = mp.cap = (i + 1) * max_points
-        mp.report(0)
-        mp.cap += max_points
     nshow = m.n
     branches, statuses, ends, levels = [], [], [], []
     for sign in (1.0, -1.0):
         P, T, status, end = _unstable_branch(mp, zs, e_u, lam, sign, delta, spacing, max_angle,
                                              length, iterates, max_points, nshow)
         branches.append(P[:, :nshow])
-        branch_done(len(branches) - 1)
+        mp.next_branch()
         levels.append(T)
         statuses.append(status)
         ends.append(end[:nshow] if end is not None else np.full(nshow, np.nan))
@@ -639,7 +645,7 @@ def manifolds(params, orbit, *, x=None, v=None, spacing: float | None = None,
     if stable:
         za = zs[act]
         M = np.asarray(orbit.monodromy.values, dtype=float)[np.ix_(act, act)]
-        Einv, e_s = _stable_coordinates(E, mu, iu, e_u[act], act, plane, planar, M)
+        Einv, e_s = _stable_coordinates(E, mu, iu, e_u[act], act, plane, M)
         stable_method = ("search: each point bisected across the curve between initial "
                          "conditions that leave the saddle along opposite unstable branches "
                          "(no inverse map)")
@@ -650,13 +656,10 @@ def manifolds(params, orbit, *, x=None, v=None, spacing: float | None = None,
                               f"through the saddle, the other coordinates the saddle's; "
                               f"homoclinic points not sought (the trace is not the manifold)")
         for sign in (1.0, -1.0):
-            W, status = _stable_branch(mp, zs[list(plane)], za, e_s, Einv, sign, delta,
-                                       spacing, max_angle, length, max_points, radius,
-                                       max_search, tol)
-            full = np.repeat(zs[None, :nshow], len(W), axis=0)
-            full[:, list(plane)] = W
-            branches.append(full)
-            branch_done(len(branches) - 1)
+            W, status = _stable_branch(mp, zs[plane], za, e_s, Einv, sign, delta, spacing,
+                                       max_angle, length, max_points, radius, max_search, tol)
+            branches.append(mp.embed(W)[:, :nshow])
+            mp.next_branch()
             levels.append(np.full(len(W), np.nan))
             statuses.append(status)
             ends.append(np.full(nshow, np.nan))
@@ -664,13 +667,12 @@ def manifolds(params, orbit, *, x=None, v=None, spacing: float | None = None,
         if planar:  # crossings of the unstable and the stable polylines
             for a in (0, 1):
                 for b in (2, 3):
-                    for pt, ang, i, j in _crossings(branches[a][:, list(plane)],
-                                                    branches[b][:, list(plane)]):
+                    for pt, ang, i, j in _crossings(branches[a][:, plane],
+                                                    branches[b][:, plane]):
                         row = np.zeros(nshow)
-                        row[list(plane)] = pt
+                        row[plane] = pt
                         cross.append((row, ang, a, b))
-        cross = [c for c in cross if window is None
-                 or _inside(c[0][None, list(plane)], window)[0]]
+        cross = [c for c in cross if window is None or _inside(c[0][None, plane], window)[0]]
     return _dataset(params, solver, k, q, zs[:nshow], mu, e_u, e_s, branches, levels,
                     statuses, ends, cross, stable_method, plane, dict(
                         spacing=spacing, delta=delta, max_angle=max_angle, length=length,
@@ -688,7 +690,7 @@ def _state_positions(setup: TangentSetup):
     return np.asarray(pos, np.int64)
 
 
-def _stable_coordinates(E, mu, iu, e_u, act, plane, planar, M):
+def _stable_coordinates(E, mu, iu, e_u, act, plane, M):
     """(Einv, e_s): the rows that give the classifier's coordinates of z - z* (row 0: the
     unstable coordinate c_u; the others: the stable part) and the stable direction in the
     plane.
@@ -700,7 +702,7 @@ def _stable_coordinates(E, mu, iu, e_u, act, plane, planar, M):
     the direction: the line where the plane meets c_u = 0."""
     at = np.flatnonzero(act)
     pa, pb = (int(np.flatnonzero(at == c)[0]) for c in plane)
-    if planar:
+    if len(at) == 2:  # a planar section
         i_s = 1 - iu
         if abs(mu[i_s].imag) > 0.0:
             raise ParameterError("orbit: complex stable multipliers")
@@ -756,7 +758,7 @@ def _dataset(params, solver, k, q, zs, mu, e_u, e_s, branches, levels, statuses,
             "saddle_V": ((), float(zs[1]), {"long_name": "V of the saddle's section point"}),
             "multiplier_real": ("multiplier", mu[order].real, {"units": "1"}),
             "multiplier_imag": ("multiplier", mu[order].imag, {"units": "1"}),
-            "unstable_direction": ("component_index", e_u[list(plane)], {
+            "unstable_direction": ("component_index", e_u[plane], {
                 "long_name": "unit eigenvector of the unstable multiplier (its components "
                              "in the plane)", "units": "1"}),
             "stable_direction": ("component_index", np.asarray(e_s, float), {
@@ -841,6 +843,9 @@ def homoclinic_tangency(params, orbit, param: str, bounds, *, tol: float = 1e-4,
                                                                                      1e-12)),
               section_phase=float(orbit.attrs.get("section_phase", 0.0)))
     evals = []
+    from ..sweep import progress_callback
+    progress = progress_callback(progress, "homoclinic tangency")
+    steps = 2 + max(0, math.ceil(math.log2(abs(b - a) / tol)))  # the ends, the bisection
 
     def saddle(value, depth=0):
         """The saddle at ``value``: Newton from the line through the two nearest saddles
@@ -869,6 +874,8 @@ def homoclinic_tangency(params, orbit, param: str, bounds, *, tol: float = 1e-4,
                                  f"slot the map depends on): homoclinic points are sought "
                                  f"in two")
         evals.append((value, int(ds.sizes["crossing"])))
+        if progress is not None:
+            progress(len(evals), steps)
         short = [b for b in BRANCH_NAMES[:2] if ds.attrs[f"status_{b}"].startswith(
             ("iterates", "max_points", "integration failed"))]
         if not ds.sizes["crossing"] and short:  # no crossing found, but not a full search
@@ -877,25 +884,15 @@ def homoclinic_tangency(params, orbit, param: str, bounds, *, tol: float = 1e-4,
                                  f"more iterates or max_points")
         return ds
 
-    from ..sweep import progress_callback
-    progress = progress_callback(progress, "homoclinic tangency")
-    steps = 2 + max(0, math.ceil(math.log2(abs(b - a) / tol)))
-
-    def crossings_counted(value):
-        ds = crossings(value)
-        if progress is not None:
-            progress(len(evals), steps)
-        return ds
-
-    lo_ds = crossings_counted(a)
+    lo_ds = crossings(a)
     if lo_ds.sizes["crossing"]:
         raise ParameterError(f"bounds: the manifolds already cross at {name} = {a:g}")
-    hi_ds = crossings_counted(b)
+    hi_ds = crossings(b)
     if not hi_ds.sizes["crossing"]:
         raise ParameterError(f"bounds: the manifolds do not cross at {name} = {b:g}")
     while abs(b - a) > tol:
         mid = 0.5 * (a + b)
-        ds = crossings_counted(mid)
+        ds = crossings(mid)
         if ds.sizes["crossing"]:
             b, hi_ds = mid, ds
         else:

@@ -456,9 +456,8 @@ class Explorer:
         self.slice_status.text = f"orbit diagram: 0 of {n} values"
         component = self.pair[0] if self.pair[0] in (0, 1) else 0
         self.slice_fig.yaxis.axis_label = f"{self.model.state_names[component]} on the section"
-        self._slice_worker.submit(params, self.method, name,
-                                                    np.linspace(lo, hi, n), list(self.u0),
-                                                    component)
+        self._slice_worker.submit(params, self.method, name, np.linspace(lo, hi, n),
+                                  list(self.u0), component)
 
     def _show_view(self, gen, orbit):
         summary = (f"{html.escape(orbit.summary())} <span style='color:#888'>"

@@ -45,7 +45,7 @@ def model(name) -> Model:
         raise ParameterError(f"model: expected a model name, got {name!r}")
     if name in BUILTIN:
         return importlib.import_module(BUILTIN[name]).MODEL
-    path, _, attr = name.partition(":") if name.count(":") and not _is_drive(name) else (name, "", "")
+    path, attr = _split_source(name)
     if path.endswith(".py"):
         return _load_user(path, attr or "MODEL")
     raise ParameterError(f"model: unknown model {name!r} (built-in: {', '.join(BUILTIN)}; or "
@@ -54,6 +54,23 @@ def model(name) -> Model:
 
 def _is_drive(name: str) -> bool:
     return len(name) > 1 and name[1] == ":" and name.count(":") == 1
+
+
+def _split_source(name: str) -> tuple[str, str]:
+    """(path, NAME) of a model given as ``path.py:NAME`` (NAME "" where it is not given)."""
+    path, _, attr = name.partition(":") if name.count(":") and not _is_drive(name) else \
+        (name, "", "")
+    return path, attr
+
+
+def file_digest(source: str) -> str | None:
+    """sha1 (16 hex digits) of the contents of a model's file (``path.py[:NAME]``, e.g. a
+    ``Model.source``), or None where it cannot be read."""
+    try:
+        with open(_split_source(source)[0], "rb") as fh:
+            return hashlib.sha1(fh.read()).hexdigest()[:16]
+    except OSError:
+        return None
 
 
 def _load_user(path: str, attr: str) -> Model:
@@ -65,10 +82,8 @@ def _load_user(path: str, attr: str) -> Model:
         raise ParameterError(f"model: no such file {path!r}")
     # the module's name comes from the file's name and contents; its numba functions are
     # cached under that name (``_numba_cache.register_user_file``), whatever folder it is in
-    with open(full, "rb") as fh:
-        digest = hashlib.sha1(fh.read()).hexdigest()[:16]
     stem = "".join(ch if ch.isalnum() else "_" for ch in os.path.basename(full))
-    modname = f"nonsmooth_user_model_{stem}_{digest}"
+    modname = f"nonsmooth_user_model_{stem}_{file_digest(full)}"
     from .._numba_cache import register_user_file
     register_user_file(full, modname)
     spec = importlib.util.spec_from_file_location(modname, full)
