@@ -1,12 +1,14 @@
 """Kernel dispatch and solver settings shared by ``simulate`` and every analysis.
 
-Every analysis core calls :func:`run` with a kernel code and the model's compiled functions
-``fns`` (a tuple of numba first-class functions, see :mod:`nonsmooth.models.base`): the
-generic kernel (:mod:`nonsmooth.integrate.hybrid`) integrates any model from ``fns``; the
-built-in ``support`` model also has specialised kernels with its functions inlined (today's
-speed), selected by their codes. Passing compiled functions as first-class ``FunctionType``
-values keeps every core cacheable on disk (a dispatcher argument would not be). A new model
-needs no edit here.
+Every analysis calls a kernel with the model's compiled functions ``fns`` (a tuple of numba
+first-class functions, see :mod:`nonsmooth.models.base`): the generic kernel
+(:mod:`nonsmooth.integrate.hybrid`) integrates any model from ``fns``; the built-in ``support``
+model also has specialised kernels with its functions inlined (today's speed). Python code calls
+:func:`run` with the kernel's code; the compiled cores that run many trajectories receive the
+kernel as a first-class function (:attr:`Solver.kernel`, :func:`tangent_function`), so that
+numba does not link and optimise the kernel again into each of them. Passing compiled functions
+as first-class ``FunctionType`` values keeps every core cacheable on disk (a dispatcher argument
+would not be). A new model needs no edit here.
 """
 
 from __future__ import annotations
@@ -22,6 +24,7 @@ import warnings
 
 from .integrate.contract import (
     DISPATCH_SIGNATURE,
+    GENERIC_KERNEL_SIGNATURE,
     KERNEL_SIGNATURE,
     MAX_GUARDS,
     N_OPTS,
@@ -40,8 +43,10 @@ from .integrate.contract import (
     ST_MODE,
     ST_V,
     ST_X,
+    TANGENT_KERNEL_SIGNATURE,
+    KernelFunction,
 )
-from .integrate.hybrid import advance_generic, frame_omega
+from .integrate.hybrid import advance_generic, advance_tangent, frame_omega
 from .models.base import DEFAULT_MODEL, KERNEL_GENERIC, KERNEL_SUPPORT_EXACT, KERNEL_SUPPORT_SMOOTH
 from .models.support.exact_kernel import advance_exact
 from .models.support.smooth_kernel import advance_smooth
@@ -70,6 +75,42 @@ def run(kernel, fns, p, opts, state, per_period, n_skip, n_out, X, V, R, M, Xmax
     if kernel == KERNEL_SUPPORT_EXACT:
         return advance_exact(p, opts, state, per_period, n_skip, n_out, X, V, R, M, Xmax, Xmin)
     return advance_smooth(p, opts, state, per_period, n_skip, n_out, X, V, R, M, Xmax, Xmin)
+
+
+@nb.njit(GENERIC_KERNEL_SIGNATURE, cache=True)
+def _support_exact(fns, p, opts, state, per_period, n_skip, n_out, X, V, R, M, Xmax, Xmin):
+    """The support model's exact kernel behind the generic signature (``fns`` unused)."""
+    return advance_exact(p, opts, state, per_period, n_skip, n_out, X, V, R, M, Xmax, Xmin)
+
+
+@nb.njit(GENERIC_KERNEL_SIGNATURE, cache=True)
+def _support_smooth(fns, p, opts, state, per_period, n_skip, n_out, X, V, R, M, Xmax, Xmin):
+    """The support model's smoothed kernel behind the generic signature (``fns`` unused)."""
+    return advance_smooth(p, opts, state, per_period, n_skip, n_out, X, V, R, M, Xmax, Xmin)
+
+
+_KERNEL_FUNCTIONS = {}
+
+
+def kernel_function(code: int) -> KernelFunction:
+    """The kernel of ``code`` (a code of ``models.base``) as a first-class function with the
+    generic kernel's signature, for the compiled cores that take it as an argument (one
+    object per process: its address is looked up once)."""
+    kf = _KERNEL_FUNCTIONS.get(code)
+    if kf is None:
+        disp = {KERNEL_GENERIC: advance_generic, KERNEL_SUPPORT_EXACT: _support_exact,
+                KERNEL_SUPPORT_SMOOTH: _support_smooth}[code]
+        kf = _KERNEL_FUNCTIONS[code] = KernelFunction(disp, GENERIC_KERNEL_SIGNATURE)
+    return kf
+
+
+def tangent_function() -> KernelFunction:
+    """``hybrid.advance_tangent`` as a first-class function (see :func:`kernel_function`)."""
+    kf = _KERNEL_FUNCTIONS.get("tangent")
+    if kf is None:
+        kf = _KERNEL_FUNCTIONS["tangent"] = KernelFunction(advance_tangent,
+                                                           TANGENT_KERNEL_SIGNATURE)
+    return kf
 
 
 @nb.njit(cache=True)
@@ -165,6 +206,11 @@ class Solver:
     def code(self) -> int:
         """Kernel code for :func:`run` (the generic kernel at a section phase other than 0)."""
         return self.spec.kernel if self.section_phase == 0.0 else KERNEL_GENERIC
+
+    @property
+    def kernel(self) -> KernelFunction:
+        """The kernel of :attr:`code` as a first-class function (:func:`kernel_function`)."""
+        return kernel_function(self.code)
 
     @property
     def fns(self) -> tuple:

@@ -18,30 +18,31 @@ import numba as nb
 import numpy as np
 
 from .errors import ParameterError
-from .kernels import Solver, run
-from .integrate.contract import MODEL_FNS_TYPE, N_STATE, OPT_N
-from .integrate.hybrid import advance_tangent
+from .kernels import Solver, tangent_function
+from .integrate.contract import KERNEL_FN_TYPE, MODEL_FNS_TYPE, N_STATE, OPT_N
 from .models.base import KERNEL_GENERIC
 
 
 _F2 = nb.float64[:, :]
 #: one signature (any layout): time slices of the outputs are non-contiguous views
-_RUN_MANY_SIG = nb.void(nb.int64, MODEL_FNS_TYPE, _F2, nb.float64[:], _F2, nb.int64, nb.int64, nb.int64, _F2, _F2,
+_RUN_MANY_SIG = nb.void(KERNEL_FN_TYPE, MODEL_FNS_TYPE, _F2, nb.float64[:], _F2, nb.int64, nb.int64, nb.int64, _F2, _F2,
                         nb.int8[:, :], nb.uint8[:, :], _F2, _F2, nb.int64[:])
 
 
 @nb.njit(_RUN_MANY_SIG, cache=True, parallel=True)
-def _run_many(method, fns, P, opts, states, per_period, n_skip, n_out, X, V, R, M, Xmax, Xmin, status):
-    """One slice of every trajectory whose ``status`` is still 0 (failed ones are skipped)."""
+def _run_many(kernel, fns, P, opts, states, per_period, n_skip, n_out, X, V, R, M, Xmax, Xmin,
+              status):
+    """One slice of every trajectory whose ``status`` is still 0 (failed ones are skipped);
+    ``kernel`` a :class:`~nonsmooth.integrate.contract.KernelFunction`."""
     for i in nb.prange(P.shape[0]):
         if status[i] == 0:
-            status[i] = run(method, fns, P[i], opts, states[i], per_period, n_skip, n_out,
+            status[i] = kernel(fns, P[i], opts, states[i], per_period, n_skip, n_out,
                                 X[i], V[i], R[i], M[i], Xmax[i], Xmin[i])
 
 
 @nb.njit(cache=True, parallel=True)
-def _run_many_components(fns, P, opts, states, per_period, n_skip, n_out, X, V, R, M, Xmax,
-                         Xmin, status, U):
+def _run_many_components(tangent, fns, P, opts, states, per_period, n_skip, n_out, X, V, R, M,
+                         Xmax, Xmin, status, U):
     """``_run_many`` on the generic kernel that also records every state component:
     U[i, k, :] = u at output k of trajectory i (``hybrid.advance_tangent`` without tangent
     vectors)."""
@@ -49,11 +50,10 @@ def _run_many_components(fns, P, opts, states, per_period, n_skip, n_out, X, V, 
     for i in nb.prange(P.shape[0]):
         if status[i] == 0:
             Ui = np.empty((n_out, n))
-            status[i] = advance_tangent(fns, P[i], opts, states[i], per_period, n_skip, n_out,
-                                        X[i], V[i], R[i], M[i], Xmax[i], Xmin[i],
-                                        np.zeros((n, 0)), np.zeros((0, 0)),
-                                        np.zeros(0, np.int64), 0, Ui, np.zeros(0),
-                                        np.zeros(4), np.zeros((0, 0)), np.zeros(0))
+            status[i] = tangent(fns, P[i], opts, states[i], per_period, n_skip, n_out, X[i],
+                                V[i], R[i], M[i], Xmax[i], Xmin[i], np.zeros((n, 0)),
+                                np.zeros((0, 0)), np.zeros(0, np.int64), 0, Ui, np.zeros(0),
+                                np.zeros(4), np.zeros((0, 0)), np.zeros(0))
             for k in range(n_out):
                 for c in range(n):
                     U[i, k, c] = Ui[k, c]
@@ -198,10 +198,11 @@ def run_trajectories(P, solver: Solver, states, *, per_period: int, n_skip: int,
                         *(out[key][sl] for key in ("X", "V", "R", "M", "Xmax", "Xmin")),
                         out["status"][a:b])
                 if full:
-                    slicer.run(lambda _size: _run_many_components(solver.fns, *args,
+                    slicer.run(lambda _size: _run_many_components(tangent_function(), solver.fns,
+                                                                  *args,
                                                                   out["U"][sl]))
                 else:
-                    slicer.run(lambda _size: _run_many(solver.code, solver.fns, *args))
+                    slicer.run(lambda _size: _run_many(solver.kernel, solver.fns, *args))
                 k += m
                 if progress is not None:
                     progress((a * total + (b - a) * k) // per_period, n * total // per_period)

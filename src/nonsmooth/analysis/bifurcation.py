@@ -22,8 +22,8 @@ import xarray as xr
 from .. import status as st
 from ..errors import ParameterError
 from ..io import apply_state_units, provenance_attrs
-from ..integrate.contract import MODEL_FNS_TYPE
-from ..kernels import Solver, mode_holds, run
+from ..integrate.contract import KERNEL_FN_TYPE, MODEL_FNS_TYPE
+from ..kernels import Solver, mode_holds
 from ..models.base import ParamsBase
 from ..sweep import parallel_chunks
 from .poincare import (MAX_PERIOD, PERIOD_LONG_NAME, SETTLE_WINDOW, classify_many, settle,
@@ -44,7 +44,7 @@ _F3 = nb.float64[:, :, :]
 _I8_2 = nb.int64[:, :]
 #: one signature (any layout): chunks of the value axis are non-contiguous views, whole small
 #: sweeps are contiguous; without it numba would compile and cache both versions
-_CONTINUATION_SIG = nb.void(nb.int64, MODEL_FNS_TYPE, _F3, nb.float64[:], nb.float64[:, :], nb.float64[:], nb.int64,
+_CONTINUATION_SIG = nb.void(KERNEL_FN_TYPE, nb.int64, MODEL_FNS_TYPE, _F3, nb.float64[:], nb.float64[:, :], nb.float64[:], nb.int64,
                             nb.float64, _F3, _F3, nb.int8[:, :, :], nb.uint8[:, :, :], _F3, _F3,
                             _I8_2, _I8_2, _F3, _I8_2, nb.int64)
 
@@ -56,7 +56,7 @@ _START, _SETTLE, _RECORD = 0, 1, 2
 
 
 @nb.njit(_CONTINUATION_SIG, cache=True, parallel=True)
-def continuation(method, fns, P, opts, states, init, transient, settle_tol,
+def continuation(kernel, method, fns, P, opts, states, init, transient, settle_tol,
                  X, V, R, M, Xmax, Xmin, status, used, S, prog, budget):
     """For every branch b (in parallel) and parameter row i (in order): continue
     ``states[b]`` with parameters ``P[b, i]`` for ``transient`` periods (ended early when
@@ -67,7 +67,8 @@ def continuation(method, fns, P, opts, states, init, transient, settle_tol,
     Resumable: each call integrates about ``budget`` forcing periods per branch and returns;
     ``states`` and the progress counters ``prog`` (branch, N_PROG; zeros to start) are updated
     in place, and the next call goes on from there. Calls cut on settle-window and period
-    boundaries, so the results do not depend on the budgets."""
+    boundaries, so the results do not depend on the budgets. ``kernel``: the solver's
+    ``KernelFunction``, ``method`` its kernel code (for ``mode_holds``)."""
     nb_, ni = P.shape[0], P.shape[1]
     nrec = X.shape[2]
     for b in nb.prange(nb_):
@@ -82,7 +83,7 @@ def continuation(method, fns, P, opts, states, init, transient, settle_tol,
             code = 0
             if prog[b, PG_PHASE] == _SETTLE:
                 d0 = prog[b, PG_DONE]
-                code, d, fin = settle(method, fns, P[b, i], opts, states[b], transient, settle_tol,
+                code, d, fin = settle(kernel, fns, P[b, i], opts, states[b], transient, settle_tol,
                                       d0, budget - work)
                 work += d - d0
                 prog[b, PG_DONE] = d
@@ -91,9 +92,9 @@ def continuation(method, fns, P, opts, states, init, transient, settle_tol,
             if code == 0 and prog[b, PG_PHASE] == _RECORD and (work < budget or nrec == 0):
                 r = prog[b, PG_REC]
                 n = min(nrec - r, max(budget - work, 1))
-                code = run(method, fns, P[b, i], opts, states[b], 1, 0, n, X[b, i, r:r + n],
-                               V[b, i, r:r + n], R[b, i, r:r + n], M[b, i, r:r + n],
-                               Xmax[b, i, r:r + n], Xmin[b, i, r:r + n])
+                code = kernel(fns, P[b, i], opts, states[b], 1, 0, n, X[b, i, r:r + n],
+                              V[b, i, r:r + n], R[b, i, r:r + n], M[b, i, r:r + n],
+                              Xmax[b, i, r:r + n], Xmin[b, i, r:r + n])
                 work += n
                 prog[b, PG_REC] = r + n
                 if code == 0 and r + n == nrec:
@@ -190,7 +191,7 @@ def follow(P, solver: Solver, states, init, transient: int, settle_tol: float, r
             args = [v[a:b] for v in (out["X"], out["V"], out["R"], out["M"], out["Xmax"],
                                      out["Xmin"], out["status"], out["used"], out["S"])]
             while np.any(prog[a:b, PG_VALUE] < nval):
-                sl.run(lambda size: continuation(solver.code, solver.fns, P[a:b], opts, states[a:b], init,
+                sl.run(lambda size: continuation(solver.kernel, solver.code, solver.fns, P[a:b], opts, states[a:b], init,
                                                  transient, settle_tol, *args, prog[a:b], size))
                 if progress is not None:
                     g = prog[:b]

@@ -71,7 +71,7 @@ BRANCH_NAMES = ("unstable_plus", "unstable_minus", "stable_plus", "stable_minus"
 
 
 @nb.njit(cache=True, parallel=True)
-def _exit_sides(method, fns, p, opts, states, q, idx, zs, Einv, r, r_lo, max_iter, side, used):
+def _exit_sides(kernel, fns, p, opts, states, q, idx, zs, Einv, r, r_lo, max_iter, side, used):
     """For each state (at a period boundary): the side (+1 / -1, the sign of c_u) on which its
     orbit under the q-period map leaves the saddle zs after having entered its box
     |c_u| < r, |c_s| < r ((c_u, c_1, c_2, ...) = Einv (z - zs), row 0 of Einv giving c_u;
@@ -90,7 +90,7 @@ def _exit_sides(method, fns, p, opts, states, q, idx, zs, Einv, r, r_lo, max_ite
         used[i] = 0
         for j in range(max_iter + 1):
             if j > 0:
-                s = run(method, fns, p, opts, states[i], 1, q - 1, 1, ox, ov, orr, om, oxa, oxi)
+                s = kernel(fns, p, opts, states[i], 1, q - 1, 1, ox, ov, orr, om, oxa, oxi)
                 used[i] = j
                 if s != 0:
                     break
@@ -171,7 +171,7 @@ class _Map:
         if n > 0 and len(Z):
             ox = np.empty((len(Z), n))
             ov = np.empty((len(Z), n))
-            _map_points(self.solver.code, self.setup.fns, self.p, self.setup.opts, states,
+            _map_points(self.solver.kernel, self.setup.fns, self.p, self.setup.opts, states,
                         self.q, ox, ov, ok)
             self.periods += len(Z) * n * self.q
         out = self.zs(states)
@@ -190,7 +190,7 @@ class _Map:
         side = np.zeros(len(Z), np.int64)
         used = np.zeros(len(Z), np.int64)
         if len(Z):
-            _exit_sides(self.solver.code, self.setup.fns, self.p, self.setup.opts, states,
+            _exit_sides(self.solver.kernel, self.setup.fns, self.p, self.setup.opts, states,
                         self.q, self.idx, zs, Einv, r, r / (2.0 * self.lam), max_iter, side,
                         used)
         self.periods += int(used.sum()) * self.q

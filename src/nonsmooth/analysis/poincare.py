@@ -55,7 +55,7 @@ from .. import status as st
 from ..errors import IntegrationError
 from ..integrate.contract import ST_MODE
 from ..io import apply_state_units, provenance_attrs
-from ..kernels import Solver, run
+from ..kernels import Solver
 from ..models.base import ParamsBase
 from .periodicity import (NOT_SETTLED, TOL_FACTOR, detect_period, section_tolerance,
                           still_converging)
@@ -108,17 +108,18 @@ def _settled(X, V, tol, pmax):
 
 
 @nb.njit(cache=True)
-def settle(method, fns, p, opts, state, transient, settle_tol, done, budget):
+def settle(kernel, fns, p, opts, state, transient, settle_tol, done, budget):
     """Continue a transient of ``transient`` forcing periods of which ``done`` are integrated
     (``state`` is updated), for about ``budget`` more periods: whole settle windows (at least
     one), so that a transient cut into such calls is identical to one call. ``settle_tol > 0``
     ends the transient early once settled (module docstring; the scale of the tolerance is the
-    largest |X|, |V| in the window). Returns (status, periods done, finished)."""
+    largest |X|, |V| in the window; ``kernel`` a ``KernelFunction``). Returns (status,
+    periods done, finished)."""
     if settle_tol <= 0.0 or transient < SETTLE_WINDOW:
         n = max(0, min(budget, transient - done))
         e0 = np.empty(0)
-        code = run(method, fns, p, opts, state, 1, n, 0, e0, e0, np.empty(0, np.int8),
-                       np.empty(0, np.uint8), e0, e0)
+        code = kernel(fns, p, opts, state, 1, n, 0, e0, e0, np.empty(0, np.int8),
+                      np.empty(0, np.uint8), e0, e0)
         done += n
         return code, done, code != 0 or done >= transient
     w = SETTLE_WINDOW
@@ -131,8 +132,8 @@ def settle(method, fns, p, opts, state, transient, settle_tol, done, budget):
     start = done
     while done < transient and (done == start or done - start < budget):
         n = min(w, transient - done)
-        code = run(method, fns, p, opts, state, 1, 0, n, bx[:n], bv[:n], br[:n], bm[:n],
-                       b1[:n], b2[:n])
+        code = kernel(fns, p, opts, state, 1, 0, n, bx[:n], bv[:n], br[:n], bm[:n], b1[:n],
+                      b2[:n])
         done += n
         if code != 0:
             return code, done, True

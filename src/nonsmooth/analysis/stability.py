@@ -25,9 +25,8 @@ import xarray as xr
 from .. import status as st
 from ..errors import IntegrationError, ParameterError
 from ..integrate.contract import ST_H, ST_MODE
-from ..integrate.hybrid import advance_tangent
 from ..io import apply_state_units, check_memory, provenance_attrs
-from ..kernels import mode_holds, output_buffers, run
+from ..kernels import mode_holds, output_buffers, run, tangent_function
 from ..models.base import KERNEL_GENERIC
 from ..simulate import (check_float, check_int, component_variables, start_attrs,
                         start_trajectory, state_u)
@@ -434,7 +433,7 @@ def _period_outputs(m):
 
 
 @nb.njit(cache=True, parallel=True)
-def _lambda1_many(fns, P, opts, states, align, periods, N, cmi, logs, status, Ys):
+def _lambda1_many(tangent, fns, P, opts, states, align, periods, N, cmi, logs, status, Ys):
     """One tangent vector per point (``Ys[i]``, carried in and out) over ``align`` + ``periods``
     periods (normalised each period): logs[i, k] = log growth of recorded period k (after the
     ``align`` periods that turn the vector into the leading direction); status[i] the kernel
@@ -445,9 +444,9 @@ def _lambda1_many(fns, P, opts, states, align, periods, N, cmi, logs, status, Ys
             Y[r, 0] = Ys[i, r]
         L = np.empty((periods, 1))
         X, V, R, M, Xa, Xb = _period_outputs(periods)
-        status[i] = advance_tangent(fns, P[i], opts, states[i], 1, align, periods, X, V, R, M,
-                                    Xa, Xb, Y, L, cmi, 1, np.zeros((0, 0)), np.zeros(0),
-                                    np.zeros(4), np.zeros((0, 0)), np.zeros(0))
+        status[i] = tangent(fns, P[i], opts, states[i], 1, align, periods, X, V, R, M, Xa, Xb,
+                            Y, L, cmi, 1, np.zeros((0, 0)), np.zeros(0), np.zeros(4),
+                            np.zeros((0, 0)), np.zeros(0))
         for k in range(periods):
             logs[i, k] = L[k, 0]
         for r in range(N):
@@ -495,8 +494,8 @@ def lambda1_points(P, solver, states, periods: int, *, blocks: int = 10, workers
         la = np.zeros((active.size, m))
         sa = np.zeros(active.size, np.int64)
         with threads(workers), deferred_interrupts():
-            _lambda1_many(setup.fns, Pa, setup.opts, Sa, align if done == 0 else 0, m,
-                          setup.N, setup.cmi, la, sa, Ya)
+            _lambda1_many(tangent_function(), setup.fns, Pa, setup.opts, Sa,
+                          align if done == 0 else 0, m, setup.N, setup.cmi, la, sa, Ya)
         S[active], Ys[active], status[active] = Sa, Ya, sa
         logs[active, done:done + m] = la
         used[active] = done + m
@@ -513,16 +512,16 @@ def lambda1_points(P, solver, states, periods: int, *, blocks: int = 10, workers
 
 
 @nb.njit(cache=True, parallel=True)
-def _monodromy_many(fns, P, opts, states, k, N, cmi, mono, status):
+def _monodromy_many(tangent, fns, P, opts, states, k, N, cmi, mono, status):
     """The monodromy (N x N) of the k[i]-fold period map from each ``states[i]`` (tangent
     kernel, no re-orthonormalisation); status[i] the kernel status."""
     for i in nb.prange(P.shape[0]):
         Y = np.eye(N)
         m = k[i]
         X, V, R, M, Xa, Xb = _period_outputs(m)
-        status[i] = advance_tangent(fns, P[i], opts, states[i], 1, 0, m, X, V, R, M, Xa, Xb,
-                                    Y, np.zeros((0, 0)), cmi, 0, np.zeros((0, 0)),
-                                    np.zeros(0), np.zeros(4), np.zeros((0, 0)), np.zeros(0))
+        status[i] = tangent(fns, P[i], opts, states[i], 1, 0, m, X, V, R, M, Xa, Xb, Y,
+                            np.zeros((0, 0)), cmi, 0, np.zeros((0, 0)), np.zeros(0),
+                            np.zeros(4), np.zeros((0, 0)), np.zeros(0))
         for a in range(N):
             for b in range(N):
                 mono[i, a, b] = Y[a, b]
@@ -545,7 +544,8 @@ def floquet_lambda1_points(P, solver, states, period, *, workers=None):
     mono = np.zeros((n, setup.N, setup.N))
     status = np.zeros(n, np.int64)
     with threads(workers), deferred_interrupts():
-        _monodromy_many(setup.fns, P, setup.opts, S, k, setup.N, setup.cmi, mono, status)
+        _monodromy_many(tangent_function(), setup.fns, P, setup.opts, S, k, setup.N, setup.cmi,
+                        mono, status)
     lam = np.full(n, np.nan)
     om = solver.model.frequency(P)
     T = 2.0 * np.pi / om

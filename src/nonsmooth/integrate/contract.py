@@ -155,3 +155,48 @@ def _signatures():
 #: literal integers that a caller happens to pass.
 KERNEL_SIGNATURE, GENERIC_KERNEL_SIGNATURE, DISPATCH_SIGNATURE, TANGENT_KERNEL_SIGNATURE = (
     _signatures())
+
+
+class KernelFunction:
+    """A kernel (``hybrid.advance_generic``, ``hybrid.advance_tangent``, or a specialised kernel
+    behind the generic signature) as a numba first-class function. The compiled cores that run
+    many trajectories take it as an argument (``KERNEL_FN_TYPE`` / ``TANGENT_FN_TYPE``) and call
+    it through its address: a core that called a kernel by name would have numba link the
+    kernel's machine code into the core and optimise it again there, about 10 s of compiling
+    for each parallel core on an empty cache (0.5 s this way), and a kernel compiled per model
+    would recompile every core. The address (numba's wrapper address protocol) is looked up
+    once per process."""
+
+    __slots__ = ("dispatcher", "type", "address")
+
+    def __init__(self, dispatcher, signature):
+        from numba import types as t
+        from numba.experimental.function_type import _get_wrapper_address
+        self.dispatcher = dispatcher
+        self.type = t.FunctionType(signature)
+        self.address = _get_wrapper_address(dispatcher, signature)
+
+    def __wrapper_address__(self, sig=None):
+        return self.address
+
+    def __call__(self, *args):
+        return self.dispatcher(*args)
+
+
+def _register_kernel_typeof():
+    from numba.extending import typeof_impl
+
+    @typeof_impl.register(KernelFunction)
+    def _typeof_kernel(val, c):
+        return val.type
+
+
+def _kernel_fn_types():
+    from numba import types as t
+    return t.FunctionType(GENERIC_KERNEL_SIGNATURE), t.FunctionType(TANGENT_KERNEL_SIGNATURE)
+
+
+#: numba types of a kernel passed as an argument (:class:`KernelFunction`): the generic
+#: signature (``fns`` first) and the tangent kernel's.
+KERNEL_FN_TYPE, TANGENT_FN_TYPE = _kernel_fn_types()
+_register_kernel_typeof()

@@ -385,7 +385,7 @@ def _run_round_points(solver, pk, X0, V0, done_before, n, max_periods, transient
 
             def call():
                 before = int(recs[active, _K].sum())
-                _run_round(solver.code, solver.fns, pk, opts, X0, V0, active, max_periods, transient, tol,
+                _run_round(solver.kernel, solver.fns, pk, opts, X0, V0, active, max_periods, transient, tol,
                            max_period, certified, apts, arad2, alab, lat.cells, lat.geo,
                            budget, states, bufs, recs, cX, cV, cxm, ofs, oi8, ou8,
                            int(axes[0]), int(axes[1]), base)

@@ -9,7 +9,6 @@ import numba as nb
 import numpy as np
 
 from ...integrate.contract import N_STATE, ST_EXTRA, ST_H, ST_MODE, ST_V, ST_VA, ST_X
-from ...kernels import run
 from ...status import NON_FINITE
 
 #: section points that must repeat beyond one period before a period q is accepted:
@@ -78,7 +77,7 @@ def _captured(x, v, apts, arad2, alab, cells, cgeo):
 
 
 @nb.njit(cache=True)
-def _follow(method, fns, p, opts, x0, v0, max_periods, transient, tol, max_period, early, apts,
+def _follow(kernel, fns, p, opts, x0, v0, max_periods, transient, tol, max_period, early, apts,
             arad2, alab, cells, cgeo, budget, state, buf, rec, cX, cV, cxm, of, oi8, ou8, ia, ib,
             base):
     """Follow one initial condition for at most ``budget`` more periods, resuming where the
@@ -114,7 +113,7 @@ def _follow(method, fns, p, opts, x0, v0, max_periods, transient, tol, max_perio
     end = min(max_periods, k + budget)
     while k < end:
         k += 1
-        s = run(method, fns, p, opts, state, 1, 0, 1, ox, ov, oi8, ou8, oxa, oxi)
+        s = kernel(fns, p, opts, state, 1, 0, 1, ox, ov, oi8, ou8, oxa, oxi)
         x = ox[0]
         v = ov[0]
         if s != 0 or not (math.isfinite(x) and math.isfinite(v)):
@@ -164,14 +163,14 @@ def _follow(method, fns, p, opts, x0, v0, max_periods, transient, tol, max_perio
 
 
 @nb.njit(cache=True, parallel=True)
-def _run_round(method, fns, p, opts, X0, V0, active, max_periods, transient, tol, max_period, early,
+def _run_round(kernel, fns, p, opts, X0, V0, active, max_periods, transient, tol, max_period, early,
                apts, arad2, alab, cells, cgeo, budget, states, bufs, recs, cX, cV, cxm, ofs,
                oi8, ou8, ia, ib, base):
     """One slice of a round: every point ``active[j]`` followed for at most ``budget`` more
     periods (``_follow``; per-point arrays indexed by the point)."""
     for j in nb.prange(active.shape[0]):
         i = active[j]
-        _follow(method, fns, p, opts, X0[i], V0[i], max_periods, transient, tol, max_period, early,
+        _follow(kernel, fns, p, opts, X0[i], V0[i], max_periods, transient, tol, max_period, early,
                 apts, arad2, alab, cells, cgeo, budget, states[i], bufs[i], recs[i], cX[i],
                 cV[i], cxm[i:i + 1], ofs[i], oi8[i], ou8[i], ia, ib, base)
 
@@ -184,7 +183,7 @@ def _one_interval():
 
 
 @nb.njit(cache=True, parallel=True)
-def _map_points(method, fns, p, opts, states, period, outX, outV, ok):
+def _map_points(kernel, fns, p, opts, states, period, outX, outV, ok):
     """Advance every state by outX.shape[1] times ``period`` forcing periods, recording its
     section point after each (outX[i, j]); rows with ok[i] False are skipped, ok[i] = False if
     the kernel failed."""
@@ -193,7 +192,7 @@ def _map_points(method, fns, p, opts, states, period, outX, outV, ok):
         for j in range(outX.shape[1]):
             if not ok[i]:
                 break
-            s = run(method, fns, p, opts, states[i], 1, period - 1, 1, ox, ov, orr, om, oxa, oxi)
+            s = kernel(fns, p, opts, states[i], 1, period - 1, 1, ox, ov, orr, om, oxa, oxi)
             if s != 0 or not (math.isfinite(ox[0]) and math.isfinite(ov[0])):
                 ok[i] = False
             outX[i, j] = ox[0]
@@ -201,7 +200,7 @@ def _map_points(method, fns, p, opts, states, period, outX, outV, ok):
 
 
 @nb.njit(cache=True, parallel=True)
-def _certify_cells(method, fns, p, opts, cx, cv, rc, todo, nsamp, m_max, apts, arad2, alab, out,
+def _certify_cells(kernel, fns, p, opts, cx, cv, rc, todo, nsamp, m_max, apts, arad2, alab, out,
                    work):
     """For every cell k listed in ``todo``: the disc of radius rc around (cx[k], cv[k]) is
     certified (out[k] = label) if, after some m <= m_max periods, the images of nsamp points of
@@ -221,7 +220,7 @@ def _certify_cells(method, fns, p, opts, cx, cv, rc, todo, nsamp, m_max, apts, a
         for m in range(m_max):
             bad = False
             for j in range(nsamp):
-                s = run(method, fns, p, opts, states[j], 1, 0, 1, ox, ov, orr, om, oxa, oxi)
+                s = kernel(fns, p, opts, states[j], 1, 0, 1, ox, ov, orr, om, oxa, oxi)
                 if s != 0 or not (math.isfinite(ox[0]) and math.isfinite(ov[0])):
                     bad = True
                     break

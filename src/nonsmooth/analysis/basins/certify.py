@@ -62,7 +62,7 @@ class _Lattice:
             b = min(len(todo), a + self.pace.share(_CELL_SAMPLES * _CELL_M_MAX))
 
             def call():
-                _certify_cells(solver.code, solver.fns, pk, solver.opts(), self.cx, self.cv, self.rc,
+                _certify_cells(solver.kernel, solver.fns, pk, solver.opts(), self.cx, self.cv, self.rc,
                                todo[a:b], _CELL_SAMPLES, _CELL_M_MAX, apts, arad2, alab, out,
                                work)
                 return int(work[todo[a:b]].sum())
@@ -95,7 +95,7 @@ def _circle_contracts(solver, pk, a, r, period, cert):
     cert["periods"] += int(_N_CIRCLE * period * _M_MAX)
     step = max(1, _MAP_WORK // (_N_CIRCLE * period))  # multiples per compiled call
     for m in range(0, _M_MAX, step):
-        _map_points(solver.code, solver.fns, pk, solver.opts(), states, period, outX[:, m:m + step],
+        _map_points(solver.kernel, solver.fns, pk, solver.opts(), states, period, outX[:, m:m + step],
                     outV[:, m:m + step], ok)
         if not ok.all():
             return False
