@@ -358,24 +358,46 @@ def test_impact_oscillator_vs_scipy(closed):
     assert abs(state[ST_X] - y_end[0]) < 1e-7 and abs(state[ST_V] - y_end[1]) < 1e-7
 
 
-@pytest.mark.parametrize("closed,tol", [(False, 1e-4), (True, 1e-9), ("general", 1e-9)])
-def test_dip_inside_a_closed_form_piece_is_not_missed(closed, tol):
-    """X = A cos(t - 0.15), unforced, rises 1e-6 above the stop at X = 1 inside the first
-    closed-form piece [0, 0.7]. The cubic Hermite of (g, g') over that piece has its minimum
-    0.0027 away from the true one, where g is positive again, so a test of g at the Hermite's
-    minimum misses the impact; the certified test finds it at t = 0.15 - arccos(1 / A) (closed
-    form; on RKF45 steps the crossing is located on the step's interpolant, whose error is
-    magnified by the grazing slope)."""
-    A = 1.0 + 1e-6
+def _dip_above_the_stop(closed, excess):
+    """X = A cos(t - 0.15), A = 1 + excess, unforced, from t = 0 against the stop at X = 1:
+    (status, time of the first impact, Xmax of the interval)."""
+    A = 1.0 + excess
     p = params(w0=1.0, xi=0.0, F0=0.0, om=0.5, r=0.8)
     opts = make_opts(rtol=1e-11, atol=1e-13, nmem=3, closed=bool(closed))
     state = make_state(A * math.cos(0.15), A * math.sin(0.15), mem=(0.0,) * 3)
     code, X, V, R, M, Xmax, Xmin = run(IMPACT_G if closed == "general" else IMPACT, p, opts,
                                        state)
-    assert code == st.OK
     assert state[ST_EXTRA] >= 1  # impacts counted
-    assert abs(state[ST_EXTRA + 1] - (0.15 - math.acos(1.0 / A))) < tol
-    assert Xmax[0] <= 1.0 + 1e-9
+    return code, state[ST_EXTRA + 1], Xmax[0]
+
+
+@pytest.mark.parametrize("closed,tol", [(False, 1e-4), (True, 1e-9), ("general", 1e-9)])
+def test_dip_inside_a_closed_form_piece_is_not_missed(closed, tol):
+    """X rises 1e-6 above the stop at X = 1 inside the first closed-form piece [0, 0.7]. The
+    cubic Hermite of (g, g') over that piece has its minimum 0.0027 away from the true one,
+    where g is positive again, so a test of g at the Hermite's minimum misses the impact; the
+    certified test finds it at t = 0.15 - arccos(1 / A) (closed form; on RKF45 steps the
+    crossing is located on the step's interpolant, whose error is magnified by the grazing
+    slope)."""
+    code, t_hit, xmax = _dip_above_the_stop(closed, 1e-6)
+    assert code == st.OK
+    assert abs(t_hit - (0.15 - math.acos(1.0 / (1.0 + 1e-6)))) < tol
+    assert xmax <= 1.0 + 1e-9
+
+
+@pytest.mark.parametrize("closed", [True, "general"])
+@pytest.mark.parametrize("excess", [1e-9, 1e-12, 1e-14])
+def test_a_nearly_tangential_touch_on_a_closed_form_piece_is_located(closed, excess):
+    """As above, with X rising only ``excess`` above the stop: the guard's two roots lie
+    2 sqrt(2 excess) apart, its slope at the first is sqrt(2 excess), so Newton's steps on the
+    closed form (``hybrid._locate_cf``) converge slowly there and the location goes on by
+    Illinois; the impact is still found (status OK), at 0.15 - arccos(1 / A) to the time
+    that the guard's round-off allows (1e-16 / slope)."""
+    code, t_hit, xmax = _dip_above_the_stop(closed, excess)
+    assert code == st.OK
+    slope = math.sqrt(2.0 * excess)
+    assert abs(t_hit - (0.15 - math.acos(1.0 / (1.0 + excess)))) < 1e-9 + 1e-14 / slope
+    assert xmax <= 1.0 + 1e-9
 
 
 def test_three_dimensional_state_and_memory():

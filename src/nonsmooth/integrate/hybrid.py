@@ -38,8 +38,10 @@ Design summary
 * ``opts[OPT_CLOSED_FORM] == 1`` and n == 2: modes that ``linear`` declares
   X'' + c X' + k X = F cos(omega t) + b (k > 0) are propagated in closed form
   (:mod:`.pwlinear`) in pieces of at most THETA = 0.7 rad of their fastest oscillation; the
-  same exit test is applied to the exact piece ends, the crossing is located by Illinois on the
-  exact closed-form state, and interior extrema of X are refined by Newton on V = 0 (exact).
+  same exit test is applied to the exact piece ends, the crossing is located by third-order
+  Newton steps on the exact closed-form state, kept in the bracket (``_locate_cf``; Illinois
+  after a few steps at a tangential touch), and interior extrema of X are refined by Halley's
+  method on V = 0, ended by a quadratic Taylor step (exact to round-off).
   The propagator of a full piece is computed once per mode and call.
 * Work arrays are views into one workspace without reference counting (:mod:`.workspace`):
   numba would otherwise increment and decrement a reference count atomically for every array
@@ -89,9 +91,9 @@ from .contract import (  # noqa: E402
     ST_X,
 )
 from .pwlinear import (BD_D2, BD_D3, BD_D4, BD_R, EXCLUDED, HERM_ERR, MC_A,  # noqa: E402
-                       MC_K, MC_LMAX, N_BD, N_MC, accel, apply_propagator, classify,
-                       energy_norm, eval_state, functional_bounds, herm_clear, herm_coeffs,
-                       hom_part, jerk, mode_coeffs, propagator)
+                       MC_C, MC_K, MC_LMAX, MC_P, MC_Q, N_BD, N_MC, accel, apply_propagator,
+                       classify, energy_norm, eval_state, functional_bounds, herm_clear,
+                       herm_coeffs, hom_part, jerk, mode_coeffs, propagator)
 from .linmodes import (N_TAYLOR, POLY_DEPTH, THETA_POLY, guard_poly, lin_matrix,  # noqa: E402
                        poly_component, poly_m4, poly_root, poly_state, poly_tangent,
                        poly_x_extrema, pval, taylor_terms)
@@ -195,12 +197,22 @@ def _rk_step(field, mode, tau, C, S, h, om, n, u, k0, pp, mem, rtol, atol, us, k
     return err2, C1, S1
 
 
+#: a Newton step on V = 0 below this fraction of the piece ends the search of an extremum of X:
+#: X there is X(s) - V^2 / (2 A) (the quadratic Taylor step), whose error, about |X''' ds^3| / 6,
+#: is below 1e-18 of the scale of X on pieces of at most THETA radians
+_EXT_STEP = 1e-6
+
+
 @nb.njit(cache=True)
 def _x_extrema_exact(MC, m, om, y0, z0, C, S, X, V, X1, V1, h, xmax, xmin):
     """Interior extrema of X on a closed-form piece of length h: first guesses from the cubic
-    Hermite of X, then Newton on V(s) = 0 with the exact state (V' = X'')."""
+    Hermite of X, then Halley's method on V(s) = 0 with the exact state (V' = X'',
+    V'' = X'''), ended by a quadratic Taylor step once the step is below ``_EXT_STEP`` h."""
     a1, a2, a3 = herm_coeffs(X, V, X1, V1, h)
     q1, q2 = quad_roots01(a1, 2.0 * a2, 3.0 * a3)
+    k = MC[m, MC_K]
+    c = MC[m, MC_C]
+    om3 = om * om * om
     for q in (q1, q2):
         if q > 0.0:
             s = q * h
@@ -210,6 +222,15 @@ def _x_extrema_exact(MC, m, om, y0, z0, C, S, X, V, X1, V1, h, xmax, xmin):
                 if As == 0.0:
                     break
                 ds = -Vs / As
+                if abs(ds) <= _EXT_STEP * h and 0.0 <= s + ds <= h:
+                    Xs -= 0.5 * Vs * Vs / As  # = X + V ds + A ds^2 / 2
+                    break
+                # Halley: X''' of the closed form, d/dt of A = -om^2 (P C + Q S) - k y - c z
+                Js = (-om3 * (MC[m, MC_Q] * Cs - MC[m, MC_P] * Ss) - k * zs
+                      - c * (-k * ys - c * zs))
+                den = 2.0 * As * As - Vs * Js
+                if den > 0.0:
+                    ds = -2.0 * Vs * As / den
                 sn = min(h, max(0.0, s + ds))
                 if abs(sn - s) <= 1e-15 * h:
                     break
@@ -350,10 +371,73 @@ def _first_negative(cf, s_end, ga, da, dda, gb, db, ddb, G, k, n, q0, q1, q2, q3
         depth = int(stack[top, 4])
 
 
+#: Newton iterations of :func:`_locate_cf` before it goes on by Illinois
+_CF_NEWTON = 8
+
+
+@nb.njit(cache=True, fastmath=_FM)
+def _locate_cf(lo, hi, glo, ghi, G, k, om, hs, MC, mode, y0, z0, C, S):
+    """The crossing of affine guard k on a closed-form piece (n = 2; fractions of the step,
+    g(lo) >= 0 > g(hi)) down to a bracket of S_TOL: third-order Newton steps (the root of the
+    local quadratic g + g' d + g'' d^2 / 2, as ``pwlinear.refine_root``) on the exact closed
+    form, from the secant point, kept in the bracket (the secant point when a step leaves it);
+    once a step is below S_TOL / 4, the next point is taken S_TOL / 2 beyond the root estimate,
+    on the far side, so that the bracket closes. A transversal crossing takes about three
+    evaluations, where Illinois took eight to ten; one that Newton has not closed after
+    ``_CF_NEWTON`` evaluations (a tangential touch, g' = 0 at the root) goes on by Illinois.
+    Returns the final (lo, hi)."""
+    kk = MC[mode, MC_K]
+    c = MC[mode, MC_C]
+    P = MC[mode, MC_P]
+    Q = MC[mode, MC_Q]
+    om2 = om * om
+    a0, a1, a2, a3, a4 = G[k, 0], G[k, 1], G[k, 2], G[k, 3], G[k, 4]
+    s = illinois_point(lo, hi, glo, ghi)
+    side = 0
+    for it in range(200):
+        if hi - lo <= S_TOL:
+            break
+        newton = it < _CF_NEWTON
+        if not newton:
+            s = illinois_point(lo, hi, glo, ghi)
+        X, V, A, y, z, Cs, Ss = eval_state(MC, mode, om, y0, z0, C, S, s * hs)
+        g = a0 * X + a1 * V + a2 + a3 * Cs + a4 * Ss
+        if not newton:
+            lo, hi, glo, ghi, side = illinois_update(lo, hi, glo, ghi, side, s, g)
+            continue
+        if g < 0.0:
+            hi = s
+            ghi = g
+        else:
+            lo = s
+            glo = g
+        if hi - lo <= S_TOL:
+            break
+        J = -om2 * om * (Q * Cs - P * Ss) - kk * z - c * (-kk * y - c * z)  # X'''
+        d = hs * (a0 * V + a1 * A + om * (a4 * Cs - a3 * Ss))
+        dd = hs * hs * (a0 * A + a1 * J - om2 * (a3 * Cs + a4 * Ss))
+        sn = -1.0
+        if d != 0.0:
+            delta = -g / d
+            disc = d * d - 2.0 * g * dd
+            if disc >= 0.0:
+                delta = -2.0 * g / (d + math.copysign(math.sqrt(disc), d))
+            if abs(delta) <= 0.25 * S_TOL:  # converged: step over the root
+                delta = math.copysign(0.5 * S_TOL, delta if delta != 0.0 else -d)
+            sn = s + delta
+        if not (lo < sn < hi):
+            sn = illinois_point(lo, hi, glo, ghi)
+        s = sn
+    return lo, hi
+
+
 @nb.njit(cache=True, inline="always", fastmath=_FM)
 def _locate(cf, lo, hi, glo, ghi, G, k, n, q0, q1, q2, q3, C, S, om, hs, MC, mode, y0, z0):
-    """Illinois on the bracket [lo, hi] (fractions of the step; g(lo) >= 0 > g(hi)) down to
-    S_TOL; returns the final (lo, hi)."""
+    """The crossing in the bracket [lo, hi] (fractions of the step; g(lo) >= 0 > g(hi)) down
+    to S_TOL: on a closed-form piece by :func:`_locate_cf`, else by Illinois on the step's
+    cubic Hermite; returns the final (lo, hi)."""
+    if cf:
+        return _locate_cf(lo, hi, glo, ghi, G, k, om, hs, MC, mode, y0, z0, C, S)
     side = 0
     for _ in range(200):
         if hi - lo <= S_TOL:
@@ -1313,16 +1397,8 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
                             continue
                         hi = s_best
                         ghi = gb
-                    lo = 0.0
-                    glo = g0
-                    side = 0
-                    for _ in range(200):
-                        if hi - lo <= S_TOL:
-                            break
-                        sm = illinois_point(lo, hi, glo, ghi)
-                        gm = _g_at(cf, sm, G, k, n, q0, q1, q2, q3, C, S, om, hs, MC, mode,
-                                   y0, z0)
-                        lo, hi, glo, ghi, side = illinois_update(lo, hi, glo, ghi, side, sm, gm)
+                    lo, hi = _locate(cf, 0.0, hi, g0, ghi, G, k, n, q0, q1, q2, q3, C, S, om,
+                                     hs, MC, mode, y0, z0)
                     if cert and lo > 0.0:  # the first crossing, not a later one
                         lo, hi = _first_crossing(cf, lo, hi, g0, d0, u, f0, C, S, G, k, n, q0,
                                                  q1, q2, q3, om, hs, MC, mode, y0, z0, MF[mode],
