@@ -508,15 +508,25 @@ def _first_crossing(cf, lo, hi, g0, d0, u, f0, C, S, G, k, n, q0, q1, q2, q3, om
                     mode, y0, z0, F, stack, BD):
     """The located crossing [lo, hi] of guard k must be its first: g >= 0 on [0, lo] is
     certified, else the crossing is located again before the first negative point found.
-    Returns the final (lo, hi)."""
+    A transversal crossing (g(lo) >= 0, g'(lo) < 0) needs no scan of its tail: g' <=
+    g'(lo) + M2 (lo - s) hs < 0 there, so g decreases to g(lo) >= 0 on
+    [lo - |g'(lo)| / (M2 hs), lo] (whose halving, down to pieces short enough for
+    ``classify``'s test from the end, took most of the scan). Returns the final (lo, hi)."""
     M2, M3, M4 = _guard_bounds(cf, G, k, n, q2, q3, om, hs, MC, mode, y0, z0, BD)
     dd0 = _g_dd(cf, G, k, n, u, f0, C, S, om, MC, mode, F, 2.0 * q2, hs)
     for _ in range(8):
         if not lo > 0.0:
             break
         gl, dl, ddl = _g_full(cf, lo, G, k, n, q0, q1, q2, q3, C, S, om, hs, MC, mode, y0, z0, F)
-        sf, gf = _first_negative(cf, lo, g0, d0, dd0, gl, dl, ddl, G, k, n, q0, q1, q2, q3, C, S,
-                                 om, hs, MC, mode, y0, z0, F, M2, M3, M4, stack)
+        s_end = lo
+        if dl < 0.0 and M2 > 0.0:
+            s_end = lo - 0.9 * (-dl / M2) / hs
+            if not s_end > 0.0:
+                break  # g >= 0 on [0, lo] (decreasing to g(lo))
+            gl, dl, ddl = _g_full(cf, s_end, G, k, n, q0, q1, q2, q3, C, S, om, hs, MC, mode, y0,
+                                  z0, F)
+        sf, gf = _first_negative(cf, s_end, g0, d0, dd0, gl, dl, ddl, G, k, n, q0, q1, q2, q3, C,
+                                 S, om, hs, MC, mode, y0, z0, F, M2, M3, M4, stack)
         if sf > 1.0:
             break
         lo, hi = _locate(cf, 0.0, sf, g0, gf, G, k, n, q0, q1, q2, q3, C, S, om, hs, MC, mode,
