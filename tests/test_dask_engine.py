@@ -32,7 +32,7 @@ def _equal(a, b):
         assert np.array_equal(a[v].values, b[v].values, equal_nan=True), v
 
 
-@pytest.mark.parametrize("analysis", ["map", "bifurcation", "basins"])
+@pytest.mark.parametrize("analysis", ["map", "bifurcation", "basins", "attractors"])
 def test_dask_results_are_the_embedded_results(analysis, client):
     call = {
         "map": lambda **kw: ns.parameter_map(P3, x=("omega", 0.85, 0.95, 10),
@@ -43,6 +43,9 @@ def test_dask_results_are_the_embedded_results(analysis, client):
             method="exact", **kw),
         "basins": lambda **kw: ns.basins(ns.preset("fig7"), grid=30, method="exact",
                                          max_periods=200, **kw),
+        "attractors": lambda **kw: ns.attractor_continuation(
+            ns.preset("fig7"), "omega", np.linspace(1.04, 1.2, 4), grid=16, method="exact",
+            **kw),
     }[analysis]
     _equal(call(engine=client), call())
 
