@@ -165,7 +165,9 @@ class KernelFunction:
     kernel's machine code into the core and optimise it again there, about 10 s of compiling
     for each parallel core on an empty cache (0.5 s this way), and a kernel compiled per model
     would recompile every core. The address (numba's wrapper address protocol) is looked up
-    once per process."""
+    once per process. Called this way, through its C wrapper as the model's functions are, a
+    kernel must never raise (the kernel contract: a status code, never an exception): numba's
+    wrapper would print an exception and return 0 (``status.OK``)."""
 
     __slots__ = ("dispatcher", "type", "address")
 
