@@ -13,6 +13,7 @@ would not be). A new model needs no edit here.
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 
@@ -89,28 +90,20 @@ def _support_smooth(fns, p, opts, state, per_period, n_skip, n_out, X, V, R, M, 
     return advance_smooth(p, opts, state, per_period, n_skip, n_out, X, V, R, M, Xmax, Xmin)
 
 
-_KERNEL_FUNCTIONS = {}
-
-
+@functools.cache
 def kernel_function(code: int) -> KernelFunction:
     """The kernel of ``code`` (a code of ``models.base``) as a first-class function with the
     generic kernel's signature, for the compiled cores that take it as an argument (one
     object per process: its address is looked up once)."""
-    kf = _KERNEL_FUNCTIONS.get(code)
-    if kf is None:
-        disp = {KERNEL_GENERIC: advance_generic, KERNEL_SUPPORT_EXACT: _support_exact,
-                KERNEL_SUPPORT_SMOOTH: _support_smooth}[code]
-        kf = _KERNEL_FUNCTIONS[code] = KernelFunction(disp, GENERIC_KERNEL_SIGNATURE)
-    return kf
+    return KernelFunction({KERNEL_GENERIC: advance_generic, KERNEL_SUPPORT_EXACT: _support_exact,
+                           KERNEL_SUPPORT_SMOOTH: _support_smooth}[code],
+                          GENERIC_KERNEL_SIGNATURE)
 
 
+@functools.cache
 def tangent_function() -> KernelFunction:
     """``hybrid.advance_tangent`` as a first-class function (see :func:`kernel_function`)."""
-    kf = _KERNEL_FUNCTIONS.get("tangent")
-    if kf is None:
-        kf = _KERNEL_FUNCTIONS["tangent"] = KernelFunction(advance_tangent,
-                                                           TANGENT_KERNEL_SIGNATURE)
-    return kf
+    return KernelFunction(advance_tangent, TANGENT_KERNEL_SIGNATURE)
 
 
 @nb.njit(cache=True)

@@ -181,9 +181,6 @@ class KernelFunction:
     def __wrapper_address__(self, sig=None):
         return self.address
 
-    def __call__(self, *args):
-        return self.dispatcher(*args)
-
 
 def _register_kernel_typeof():
     from numba.extending import typeof_impl

@@ -91,9 +91,9 @@ from .contract import (  # noqa: E402
     ST_X,
 )
 from .pwlinear import (BD_D2, BD_D3, BD_D4, BD_R, EXCLUDED, HERM_ERR, MC_A,  # noqa: E402
-                       MC_C, MC_K, MC_LMAX, MC_P, MC_Q, N_BD, N_MC, accel, apply_propagator,
-                       classify, energy_norm, eval_state, functional_bounds, herm_clear,
-                       herm_coeffs, hom_part, jerk, mode_coeffs, propagator)
+                       MC_K, MC_LMAX, N_BD, N_MC, accel, apply_propagator, classify,
+                       energy_norm, eval_state, functional_bounds, herm_clear, herm_coeffs,
+                       hom_part, jerk, mode_coeffs, propagator)
 from .linmodes import (N_TAYLOR, POLY_DEPTH, THETA_POLY, guard_poly, lin_matrix,  # noqa: E402
                        poly_component, poly_m4, poly_root, poly_state, poly_tangent,
                        poly_x_extrema, pval, taylor_terms)
@@ -204,15 +204,13 @@ _EXT_STEP = 1e-6
 
 
 @nb.njit(cache=True)
-def _x_extrema_exact(MC, m, om, y0, z0, C, S, X, V, X1, V1, h, xmax, xmin):
-    """Interior extrema of X on a closed-form piece of length h: first guesses from the cubic
-    Hermite of X, then Halley's method on V(s) = 0 with the exact state (V' = X'',
-    V'' = X'''), ended by a quadratic Taylor step once the step is below ``_EXT_STEP`` h."""
+def _x_extrema_exact(MC, m, om, F, y0, z0, C, S, X, V, X1, V1, h, xmax, xmin):
+    """Interior extrema of X on a closed-form piece of length h (F: the mode's forcing
+    amplitude): first guesses from the cubic Hermite of X, then Halley's method on V(s) = 0
+    with the exact state (V' = X'', V'' = X''' = ``pwlinear.jerk``), ended by a quadratic
+    Taylor step once the step is below ``_EXT_STEP`` h."""
     a1, a2, a3 = herm_coeffs(X, V, X1, V1, h)
     q1, q2 = quad_roots01(a1, 2.0 * a2, 3.0 * a3)
-    k = MC[m, MC_K]
-    c = MC[m, MC_C]
-    om3 = om * om * om
     for q in (q1, q2):
         if q > 0.0:
             s = q * h
@@ -225,10 +223,7 @@ def _x_extrema_exact(MC, m, om, y0, z0, C, S, X, V, X1, V1, h, xmax, xmin):
                 if abs(ds) <= _EXT_STEP * h and 0.0 <= s + ds <= h:
                     Xs -= 0.5 * Vs * Vs / As  # = X + V ds + A ds^2 / 2
                     break
-                # Halley: X''' of the closed form, d/dt of A = -om^2 (P C + Q S) - k y - c z
-                Js = (-om3 * (MC[m, MC_Q] * Cs - MC[m, MC_P] * Ss) - k * zs
-                      - c * (-k * ys - c * zs))
-                den = 2.0 * As * As - Vs * Js
+                den = 2.0 * As * As - Vs * jerk(MC, m, om, F, Vs, As, Ss)  # Halley
                 if den > 0.0:
                     ds = -2.0 * Vs * As / den
                 sn = min(h, max(0.0, s + ds))
@@ -376,7 +371,7 @@ _CF_NEWTON = 8
 
 
 @nb.njit(cache=True, fastmath=_FM)
-def _locate_cf(lo, hi, glo, ghi, G, k, om, hs, MC, mode, y0, z0, C, S):
+def _locate_cf(lo, hi, glo, ghi, G, k, om, hs, MC, mode, y0, z0, C, S, F):
     """The crossing of affine guard k on a closed-form piece (n = 2; fractions of the step,
     g(lo) >= 0 > g(hi)) down to a bracket of S_TOL: third-order Newton steps (the root of the
     local quadratic g + g' d + g'' d^2 / 2, as ``pwlinear.refine_root``) on the exact closed
@@ -385,11 +380,8 @@ def _locate_cf(lo, hi, glo, ghi, G, k, om, hs, MC, mode, y0, z0, C, S):
     on the far side, so that the bracket closes. A transversal crossing takes about three
     evaluations, where Illinois took eight to ten; one that Newton has not closed after
     ``_CF_NEWTON`` evaluations (a tangential touch, g' = 0 at the root) goes on by Illinois.
-    Returns the final (lo, hi)."""
-    kk = MC[mode, MC_K]
-    c = MC[mode, MC_C]
-    P = MC[mode, MC_P]
-    Q = MC[mode, MC_Q]
+    F: the mode's forcing amplitude (for X''' = ``pwlinear.jerk``). Returns the final
+    (lo, hi)."""
     om2 = om * om
     a0, a1, a2, a3, a4 = G[k, 0], G[k, 1], G[k, 2], G[k, 3], G[k, 4]
     s = illinois_point(lo, hi, glo, ghi)
@@ -413,7 +405,7 @@ def _locate_cf(lo, hi, glo, ghi, G, k, om, hs, MC, mode, y0, z0, C, S):
             glo = g
         if hi - lo <= S_TOL:
             break
-        J = -om2 * om * (Q * Cs - P * Ss) - kk * z - c * (-kk * y - c * z)  # X'''
+        J = jerk(MC, mode, om, F, V, A, Ss)
         d = hs * (a0 * V + a1 * A + om * (a4 * Cs - a3 * Ss))
         dd = hs * hs * (a0 * A + a1 * J - om2 * (a3 * Cs + a4 * Ss))
         sn = -1.0
@@ -432,12 +424,13 @@ def _locate_cf(lo, hi, glo, ghi, G, k, om, hs, MC, mode, y0, z0, C, S):
 
 
 @nb.njit(cache=True, inline="always", fastmath=_FM)
-def _locate(cf, lo, hi, glo, ghi, G, k, n, q0, q1, q2, q3, C, S, om, hs, MC, mode, y0, z0):
+def _locate(cf, lo, hi, glo, ghi, G, k, n, q0, q1, q2, q3, C, S, om, hs, MC, mode, y0, z0,
+            F):
     """The crossing in the bracket [lo, hi] (fractions of the step; g(lo) >= 0 > g(hi)) down
     to S_TOL: on a closed-form piece by :func:`_locate_cf`, else by Illinois on the step's
-    cubic Hermite; returns the final (lo, hi)."""
+    cubic Hermite (F: the mode's forcing amplitude); returns the final (lo, hi)."""
     if cf:
-        return _locate_cf(lo, hi, glo, ghi, G, k, om, hs, MC, mode, y0, z0, C, S)
+        return _locate_cf(lo, hi, glo, ghi, G, k, om, hs, MC, mode, y0, z0, C, S, F)
     side = 0
     for _ in range(200):
         if hi - lo <= S_TOL:
@@ -530,7 +523,7 @@ def _first_crossing(cf, lo, hi, g0, d0, u, f0, C, S, G, k, n, q0, q1, q2, q3, om
         if sf > 1.0:
             break
         lo, hi = _locate(cf, 0.0, sf, g0, gf, G, k, n, q0, q1, q2, q3, C, S, om, hs, MC, mode,
-                         y0, z0)
+                         y0, z0, F)
     return lo, hi
 
 
@@ -1408,7 +1401,7 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
                         hi = s_best
                         ghi = gb
                     lo, hi = _locate(cf, 0.0, hi, g0, ghi, G, k, n, q0, q1, q2, q3, C, S, om,
-                                     hs, MC, mode, y0, z0)
+                                     hs, MC, mode, y0, z0, MF[mode])
                     if cert and lo > 0.0:  # the first crossing, not a later one
                         lo, hi = _first_crossing(cf, lo, hi, g0, d0, u, f0, C, S, G, k, n, q0,
                                                  q1, q2, q3, om, hs, MC, mode, y0, z0, MF[mode],
@@ -1484,8 +1477,8 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
                     h = _control(max(err2, errY2), hs, h, last, rejected)
                     rejected = False
                 if cf:
-                    xmax, xmin = _x_extrema_exact(MC, mode, om, y0, z0, C, S, u[0], u[1], u1[0],
-                                                  u1[1], hs, xmax, xmin)
+                    xmax, xmin = _x_extrema_exact(MC, mode, om, MF[mode], y0, z0, C, S, u[0],
+                                                  u[1], u1[0], u1[1], hs, xmax, xmin)
                 elif pm:
                     xmax, xmin = poly_x_extrema(TW, hs, xmax, xmin, cp)
                 else:
