@@ -536,3 +536,53 @@ def test_general_linear_modes_in_closed_form():
         assert np.max(np.abs(got - want)) < 1e-12 * np.abs(want).max()
         assert abs(V[-1] - (V0 + b * t[-1])) < 1e-12 * abs(V0 + b * t[-1])
         assert abs(state[ST_EXTRA] - math.exp(-t[-1])) < 1e-13 * math.exp(-t[-1])
+
+
+def test_series_primitives_against_exact_arithmetic():
+    """``linmodes``' evaluation primitives against oracles: ``pval`` / ``pvalue`` (Horner in
+    s^4 over four residues) and the bound ``poly_m4`` against the same sums in exact rational
+    arithmetic, to a few ulp of the sum of the terms' magnitudes; ``taylor_terms`` from
+    ``series_powers`` (M^j / j! once per mode) summed at s against scipy's ``expm(M s) z0``."""
+    from fractions import Fraction
+
+    import scipy.linalg
+
+    from nonsmooth.integrate.linmodes import (N_TAYLOR, lin_matrix, poly_m4, pval, pvalue,
+                                              series_powers, taylor_terms)
+    rng = np.random.default_rng(7)
+    fact = np.array([float(math.factorial(j)) for j in range(N_TAYLOR + 1)])
+    for _ in range(20):
+        c = rng.normal(size=N_TAYLOR + 1) * 2.0 ** np.arange(N_TAYLOR + 1) / fact
+        s = float(rng.uniform(-1.0, 1.0))
+        b = float(rng.uniform(0.0, 1.0))
+        cf = [Fraction(x) for x in c]
+        sf, bf = Fraction(s), Fraction(b)
+        val = sum(cf[j] * sf ** j for j in range(N_TAYLOR + 1))
+        der = sum(j * cf[j] * sf ** (j - 1) for j in range(1, N_TAYLOR + 1))
+        m4 = sum(abs(cf[j]) * j * (j - 1) * (j - 2) * (j - 3) * bf ** (j - 4)
+                 for j in range(4, N_TAYLOR + 1))
+        scale = float(sum(abs(cf[j]) * abs(sf) ** j for j in range(N_TAYLOR + 1)))
+        dscale = float(sum(j * abs(cf[j]) * abs(sf) ** (j - 1) for j in range(1, N_TAYLOR + 1)))
+        v, d = pval(c, s)
+        assert abs(v - float(val)) <= 8 * 2.0 ** -52 * scale
+        assert abs(d - float(der)) <= 8 * 2.0 ** -52 * dscale
+        assert pvalue(c, s) == v
+        assert abs(poly_m4(c, b) - float(m4)) <= 8 * 2.0 ** -52 * float(m4)
+    n, om = 3, 1.3
+    A = rng.normal(size=(n, n))
+    lin = np.concatenate([A.ravel(), rng.normal(size=3 * n)])
+    m = n + 3
+    Mx = np.zeros(m * m)
+    rho = lin_matrix(lin, n, om, Mx)
+    PW = np.zeros((N_TAYLOR + 1, m * m))
+    series_powers(Mx, m, PW)
+    u = rng.normal(size=n)
+    C, S = math.cos(0.4), math.sin(0.4)
+    TW = np.zeros((N_TAYLOR + 1, m))
+    taylor_terms(PW, n, u, C, S, TW)
+    z0 = np.concatenate([u, [1.0, C, S]])
+    for s in (0.3 / rho, 2.0 / rho):  # up to a full piece, THETA_POLY / rho
+        want = scipy.linalg.expm(Mx.reshape(m, m) * s) @ z0
+        got = np.array([pvalue(TW[:, i], s) for i in range(m)])
+        assert np.max(np.abs(got - want)) < 1e-13 * np.abs(want).max()
+        assert abs(got[n + 1] - math.cos(0.4 + om * s)) < 1e-14  # the forcing rows rotate

@@ -96,7 +96,7 @@ from .pwlinear import (BD_D2, BD_D3, BD_D4, BD_R, EXCLUDED, HERM_ERR, MC_A,  # n
                        hom_part, jerk, mode_coeffs, propagator)
 from .linmodes import (N_TAYLOR, POLY_DEPTH, THETA_POLY, guard_poly, lin_matrix,  # noqa: E402
                        poly_component, poly_m4, poly_root, poly_state, poly_tangent,
-                       poly_x_extrema, pval, taylor_terms)
+                       poly_x_extrema, pval, series_powers, taylor_terms)
 from .record import record_interval  # noqa: E402
 from .roots import illinois_point, illinois_update, quad_roots01  # noqa: E402
 from .rkstep import (_A, _B, _C, _E, _FM, _NS, _control, _cubic, _shrink,  # noqa: E402
@@ -453,10 +453,10 @@ def frame_omega(pp, opts):
 
 
 @nb.njit(cache=True)
-def _mode_class(linear, closed, mode, pp, lin, MC, mcs, om, MF, n, MX, MXR):
+def _mode_class(linear, closed, mode, pp, lin, MC, mcs, om, MF, n, MX, MXR, PW):
     """_MC_CLOSED / _MC_RK / _MC_RESONANT / _MC_POLY for ``mode``, filling the table row (and
-    the forcing amplitude ``MF[mode]``, or the augmented matrix ``MX[mode]`` and its rate
-    ``MXR[mode]``) lazily."""
+    the forcing amplitude ``MF[mode]``, or the augmented matrix ``MX[mode]``, its rate
+    ``MXR[mode]`` and its series' matrices ``PW[mode]``) lazily."""
     if not closed:
         return _MC_RK
     if mcs[mode] == _MC_UNKNOWN:
@@ -470,6 +470,7 @@ def _mode_class(linear, closed, mode, pp, lin, MC, mcs, om, MF, n, MX, MXR):
                 mcs[mode] = _MC_RESONANT
         elif r == 2:
             MXR[mode] = lin_matrix(lin, n, om, MX[mode])
+            series_powers(MX[mode], n + 3, PW[mode])
             mcs[mode] = _MC_POLY
     return int(mcs[mode])
 
@@ -1100,7 +1101,9 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
     total = 0
     for z in sizes:
         total += z
-    ws = np.zeros(total)
+    npw = MAX_MODES * (N_TAYLOR + 1) * m3 * m3  # the series' matrices: filled before use
+    ws = np.empty(total + npw)
+    ws[:total] = 0.0
     o = 0
     pp = view(ws, o, (len(p),))
     o += len(p)
@@ -1154,6 +1157,7 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
     o += N_TAYLOR + 1
     rows = view(ws, o, (2, n))
     pt0, pt1 = rows[0], rows[1]
+    PW = view(ws, total, (MAX_MODES, N_TAYLOR + 1, m3 * m3))  # M^j / j! of each _MC_POLY mode
     if o + 2 * n != total:  # the views above and ``sizes`` must agree (views are not bounds-
         return st.NON_FINITE  # checked); a mismatch is a bug of this function, caught by tests
     pp[:] = p
@@ -1219,7 +1223,7 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
         sgn = _section_side(G, ng, H, n, u, f0, C0, S0, om)
         ksec = ng
         ng += 1
-    cls = _mode_class(linear, closed, mode, pp, lin, MC, mcs, om, MF, n, MX, MXR)
+    cls = _mode_class(linear, closed, mode, pp, lin, MC, mcs, om, MF, n, MX, MXR, PW)
     if cls == _MC_RESONANT:
         _store(state, u, n, mem, nmem, mode, h)
         keep_alive(ws)
@@ -1286,7 +1290,7 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
                     Lm = THETA_POLY / MXR[mode]
                     last = Lm >= rem
                     hs = rem if last else Lm
-                    taylor_terms(MX[mode], n, u, C, S, TW)
+                    taylor_terms(PW[mode], n, u, C, S, TW)
                     poly_state(TW, n, hs, u1)
                     C1, S1 = _rotate(C, S, om * hs)
                     if not _finite(u1, n):
@@ -1548,7 +1552,7 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
                         break
                     ksec = ng
                     ng += 1
-                cls = _mode_class(linear, closed, mode, pp, lin, MC, mcs, om, MF, n, MX, MXR)
+                cls = _mode_class(linear, closed, mode, pp, lin, MC, mcs, om, MF, n, MX, MXR, PW)
                 if cls == _MC_RESONANT:
                     code = st.RESONANCE
                     break

@@ -29,9 +29,10 @@ import numpy as np
 
 
 THETA_POLY = 2.0  # rho L on a full piece
-N_TAYLOR = 28  # terms beyond the constant one
+N_TAYLOR = 28  # terms beyond the constant one (a multiple of 4: ``pval``)
 POLY_DEPTH = 30  # halvings of a piece in its exit test (<= hybrid.SCAN_DEPTH: its stack)
 X_SAMPLES = 4  # samples of V per piece for the extrema of X
+_HERMITE_TOL = 1e-9  # the first guess of ``poly_root``: fraction of its bracket
 
 
 @nb.njit(cache=True)
@@ -80,8 +81,32 @@ def lin_matrix(lin, n, om, Mx):
 
 
 @nb.njit(cache=True, fastmath={"contract", "reassoc"})
-def taylor_terms(Mx, n, u, C, S, TW):
-    """TW[j] = M^j z0 / j! (j = 0..N_TAYLOR) for z0 = (u, 1, C, S)."""
+def series_powers(Mx, m, PW):
+    """PW[j] = M^j / j! (j = 0..N_TAYLOR; each m x m, row-major in the flat PW[j]): the
+    series' matrices of a mode, computed once per mode and call (``taylor_terms`` then costs
+    one product with z0 per term, independent of each other, instead of a chain of N_TAYLOR
+    products each waiting for the last)."""
+    mm = m * m
+    for i in range(mm):
+        PW[0, i] = 0.0
+    for i in range(m):
+        PW[0, i * m + i] = 1.0
+    for j in range(1, N_TAYLOR + 1):
+        inv = 1.0 / j
+        for i in range(m):
+            for q in range(m):
+                acc = 0.0
+                for r in range(m):
+                    acc += Mx[i * m + r] * PW[j - 1, r * m + q]
+                PW[j, i * m + q] = acc * inv
+
+
+@nb.njit(cache=True, fastmath={"contract", "reassoc"})
+def taylor_terms(PW, n, u, C, S, TW):
+    """TW[j] = M^j z0 / j! (j = 0..N_TAYLOR) for z0 = (u, 1, C, S), from the matrices PW[j]
+    = M^j / j! (``series_powers``). The sums read u, C and S, not TW[0]: a store into TW
+    would otherwise order every later load of z0 behind it (the arrays may alias), about
+    twice the time."""
     m = n + 3
     for i in range(n):
         TW[0, i] = u[i]
@@ -89,33 +114,72 @@ def taylor_terms(Mx, n, u, C, S, TW):
     TW[0, n + 1] = C
     TW[0, n + 2] = S
     for j in range(1, N_TAYLOR + 1):
-        inv = 1.0 / j
         for i in range(m):
-            acc = 0.0
-            for q in range(m):
-                acc += Mx[i * m + q] * TW[j - 1, q]
-            TW[j, i] = acc * inv
+            r = i * m
+            acc = PW[j, r + n] + PW[j, r + n + 1] * C + PW[j, r + n + 2] * S
+            for q in range(n):
+                acc += PW[j, r + q] * u[q]
+            TW[j, i] = acc
+
+
+@nb.njit(cache=True, inline="always", fastmath={"contract"})
+def pvalue(c, s):
+    """p(s) of the polynomial c of degree N_TAYLOR (any 1-d array, also a column of TW): Horner
+    in s^4 over the four residues of the exponent mod 4, four independent chains of
+    N_TAYLOR / 4 steps instead of one of N_TAYLOR (evaluation is latency-bound)."""
+    s2 = s * s
+    s4 = s2 * s2
+    a0 = c[N_TAYLOR]
+    a1 = 0.0
+    a2 = 0.0
+    a3 = 0.0
+    for k in range(N_TAYLOR // 4 - 1, -1, -1):
+        b = 4 * k
+        a0 = a0 * s4 + c[b]
+        a1 = a1 * s4 + c[b + 1]
+        a2 = a2 * s4 + c[b + 2]
+        a3 = a3 * s4 + c[b + 3]
+    return (a0 + s * a1) + s2 * (a2 + s * a3)
+
+
+@nb.njit(cache=True, inline="always", fastmath={"contract"})
+def pval(c, s):
+    """(p(s), p'(s)) of the polynomial c of degree N_TAYLOR (``pvalue``'s four chains, and four
+    more for p' = sum_i (i + 1) c[i + 1] s^i)."""
+    s2 = s * s
+    s4 = s2 * s2
+    a0 = c[N_TAYLOR]
+    a1 = 0.0
+    a2 = 0.0
+    a3 = 0.0
+    d0 = 0.0
+    d1 = 0.0
+    d2 = 0.0
+    d3 = 0.0
+    for k in range(N_TAYLOR // 4 - 1, -1, -1):
+        b = 4 * k
+        a0 = a0 * s4 + c[b]
+        a1 = a1 * s4 + c[b + 1]
+        a2 = a2 * s4 + c[b + 2]
+        a3 = a3 * s4 + c[b + 3]
+        d0 = d0 * s4 + (b + 1) * c[b + 1]
+        d1 = d1 * s4 + (b + 2) * c[b + 2]
+        d2 = d2 * s4 + (b + 3) * c[b + 3]
+        d3 = d3 * s4 + (b + 4) * c[b + 4]
+    return (a0 + s * a1) + s2 * (a2 + s * a3), (d0 + s * d1) + s2 * (d2 + s * d3)
 
 
 @nb.njit(cache=True, inline="always")
 def poly_state(TW, n, s, out):
-    """out[0:n] = u(s) (Horner over the Taylor terms)."""
+    """out[0:n] = u(s) (``pvalue`` of each component's Taylor terms)."""
     for i in range(n):
-        acc = TW[N_TAYLOR, i]
-        for j in range(N_TAYLOR - 1, -1, -1):
-            acc = acc * s + TW[j, i]
-        out[i] = acc
+        out[i] = pvalue(TW[:, i], s)
 
 
 @nb.njit(cache=True, inline="always")
 def poly_component(TW, i, s):
     """(value, derivative) at s of component i of z."""
-    v = TW[N_TAYLOR, i]
-    d = N_TAYLOR * TW[N_TAYLOR, i]
-    for j in range(N_TAYLOR - 1, 0, -1):
-        v = v * s + TW[j, i]
-        d = d * s + j * TW[j, i]
-    return v * s + TW[0, i], d
+    return pval(TW[:, i], s)
 
 
 @nb.njit(cache=True)
@@ -130,24 +194,25 @@ def guard_poly(G, k, n, TW, c):
 
 
 @nb.njit(cache=True, inline="always")
-def pval(c, s):
-    """(p(s), p'(s)) of the polynomial c."""
-    v = c[N_TAYLOR]
-    d = N_TAYLOR * c[N_TAYLOR]
-    for j in range(N_TAYLOR - 1, 0, -1):
-        v = v * s + c[j]
-        d = d * s + j * c[j]
-    return v * s + c[0], d
-
-
-@nb.njit(cache=True, inline="always")
 def poly_m4(c, b):
     """Bound of |p''''| on [0, b] from the coefficients (plus the series' remainder, far
     below round-off on a piece)."""
-    acc = 0.0
-    for j in range(N_TAYLOR, 3, -1):  # Horner in b
-        acc = acc * b + abs(c[j]) * (j * (j - 1) * (j - 2) * (j - 3))
-    return acc
+    b2 = b * b
+    b4 = b2 * b2
+    # sum over j = 4..N_TAYLOR of |c_j| j (j-1) (j-2) (j-3) b^(j-4): Horner in b^4 over the
+    # four residues of j mod 4 (as ``pval``)
+    j = N_TAYLOR
+    a0 = abs(c[j]) * (j * (j - 1) * (j - 2) * (j - 3))
+    a1 = 0.0
+    a2 = 0.0
+    a3 = 0.0
+    for k in range(N_TAYLOR // 4 - 2, -1, -1):
+        j = 4 * k + 4
+        a0 = a0 * b4 + abs(c[j]) * (j * (j - 1) * (j - 2) * (j - 3))
+        a1 = a1 * b4 + abs(c[j + 1]) * ((j + 1) * j * (j - 1) * (j - 2))
+        a2 = a2 * b4 + abs(c[j + 2]) * ((j + 2) * (j + 1) * j * (j - 1))
+        a3 = a3 * b4 + abs(c[j + 3]) * ((j + 3) * (j + 2) * (j + 1) * j)
+    return (a0 + b * a1) + b2 * (a2 + b * a3)
 
 
 @nb.njit(cache=True)
@@ -201,11 +266,12 @@ def poly_root(c, hs, lo, hi, glo, ghi, tol):
     """The bracket [lo, hi] (fractions of the piece of length hs; p(lo hs) = glo >= 0 >
     ghi = p(hi hs)) of a root of the polynomial c, shrunk to ``tol``. Newton on p (its
     derivative comes with its value), started at the root of the cubic Hermite of (p, p') at
-    the bracket's ends and kept inside the bracket; a step that leaves it or does not halve
-    the previous one is replaced by the bracket's midpoint. Converged, an iterate steps tol / 2
-    past the root so that the bracket closes from both sides. (Illinois bisects while
-    p(lo) = 0, as after a reset onto the guard's surface: some 20 steps more for a flight of
-    1e-6 of the piece.) Returns (lo, hi)."""
+    the bracket's ends (to ``_HERMITE_TOL`` of the bracket: a first guess, which the Newton
+    steps on p refine; with p(lo) = 0, as after a reset onto the guard's surface, the root of
+    H(u) / u, so that the Hermite's root at the bracket's start does not attract it) and kept
+    inside the bracket; a step that leaves it or does not halve the previous one is replaced by
+    the bracket's midpoint. Converged, an iterate steps tol / 2 past the root so that the
+    bracket closes from both sides. Returns (lo, hi)."""
     L = (hi - lo) * hs
     dlo = pval(c, lo * hs)[1] * L
     dhi = pval(c, hi * hs)[1] * L
@@ -216,20 +282,25 @@ def poly_root(c, hs, lo, hi, glo, ghi, tol):
     a3 = -2.0 * dg + dlo + dhi
     ul = 0.0
     uh = 1.0
-    u = glo / (glo - ghi)
+    defl = glo == 0.0 and a1 > 0.0  # H(0) = 0, moving in: the root of H(u) / u
+    u = a1 / (a1 - ghi) if defl else glo / (glo - ghi)
     for _ in range(60):
-        h = glo + u * (a1 + u * (a2 + u * a3))
+        if defl:
+            h = a1 + u * (a2 + u * a3)
+            hp = a2 + 2.0 * u * a3
+        else:
+            h = glo + u * (a1 + u * (a2 + u * a3))
+            hp = a1 + u * (2.0 * a2 + 3.0 * u * a3)
         if h < 0.0:
             uh = u
         else:
             ul = u
-        hp = a1 + u * (2.0 * a2 + 3.0 * u * a3)
         un = u - h / hp if hp != 0.0 else -1.0
         if not ul < un < uh:
             un = 0.5 * (ul + uh)
-        done = abs(un - u) <= 1e-3 * tol
+        done = abs(un - u) <= _HERMITE_TOL
         u = un
-        if done or uh - ul <= 1e-3 * tol:
+        if done or uh - ul <= _HERMITE_TOL:
             break
     x = lo + u * (hi - lo)
     if not lo < x < hi:
