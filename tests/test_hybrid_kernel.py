@@ -542,13 +542,14 @@ def test_series_primitives_against_exact_arithmetic():
     """``linmodes``' evaluation primitives against oracles: ``pval`` / ``pvalue`` (Horner in
     s^4 over four residues) and the bound ``poly_m4`` against the same sums in exact rational
     arithmetic, to a few ulp of the sum of the terms' magnitudes; ``taylor_terms`` from
-    ``series_powers`` (M^j / j! once per mode) summed at s against scipy's ``expm(M s) z0``."""
+    ``series_powers`` (M^j / j! once per mode) summed at s against scipy's ``expm(M s) z0``,
+    and ``poly_tangent`` against ``expm(A s)`` on the state rows of tangent vectors."""
     from fractions import Fraction
 
     import scipy.linalg
 
-    from nonsmooth.integrate.linmodes import (N_TAYLOR, lin_matrix, poly_m4, pval, pvalue,
-                                              series_powers, taylor_terms)
+    from nonsmooth.integrate.linmodes import (N_TAYLOR, lin_matrix, poly_m4, poly_tangent, pval,
+                                              pvalue, series_powers, taylor_terms)
     rng = np.random.default_rng(7)
     fact = np.array([float(math.factorial(j)) for j in range(N_TAYLOR + 1)])
     for _ in range(20):
@@ -586,3 +587,9 @@ def test_series_primitives_against_exact_arithmetic():
         got = np.array([pvalue(TW[:, i], s) for i in range(m)])
         assert np.max(np.abs(got - want)) < 1e-13 * np.abs(want).max()
         assert abs(got[n + 1] - math.cos(0.4 + om * s)) < 1e-14  # the forcing rows rotate
+        # the tangent: exp(A s) on the state rows, memory rows left alone
+        Y = rng.normal(size=(n + 1, 2))
+        want_Y = Y.copy()
+        want_Y[:n] = scipy.linalg.expm(A * s) @ Y[:n]
+        poly_tangent(PW, n, s, Y, np.zeros((n, n)), np.zeros(n))
+        assert np.max(np.abs(Y - want_Y)) < 1e-13 * np.abs(want_Y).max()

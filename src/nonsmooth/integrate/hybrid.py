@@ -1097,7 +1097,7 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
     sizes = (len(p), 10 * n, nme, MAX_GUARDS * (n + 3), MAX_MODES * (N_MC + 7), nlin,
              N_BD * (1 + MAX_GUARDS), (SCAN_DEPTH + 1) * 5, _NS * nt * mt, 6 * nt + nt * nj,
              2 * nme if tan else 0, len(cmi), mt, n + 1,
-             MAX_MODES * (m3 * m3 + 1) + (N_TAYLOR + 1) * (m3 + 1) + 2 * n)
+             MAX_MODES * (m3 * m3 + 1) + (N_TAYLOR + 1) * (m3 + 1) + n * n + n)
     total = 0
     for z in sizes:
         total += z
@@ -1155,10 +1155,10 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
     o += (N_TAYLOR + 1) * m3
     cp = view(ws, o, (N_TAYLOR + 1,))  # a guard as a polynomial on the piece
     o += N_TAYLOR + 1
-    rows = view(ws, o, (2, n))
-    pt0, pt1 = rows[0], rows[1]
+    PE = view(ws, o, (n, n))  # exp(A h) of a series piece, for the tangent
+    pt = view(ws, o + n * n, (n,))
     PW = view(ws, total, (MAX_MODES, N_TAYLOR + 1, m3 * m3))  # M^j / j! of each _MC_POLY mode
-    if o + 2 * n != total:  # the views above and ``sizes`` must agree (views are not bounds-
+    if o + n * n + n != total:  # the views above and ``sizes`` must agree (views are not bounds-
         return st.NON_FINITE  # checked); a mismatch is a bug of this function, caught by tests
     pp[:] = p
     Y = unowned(Y)  # owned by the caller for the whole call
@@ -1469,7 +1469,7 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
                     if cf:
                         _cf_tangent(MC, mode, om, hs, Y, PT)
                     elif pm:
-                        poly_tangent(MX[mode], n, hs, Y, pt0, pt1)
+                        poly_tangent(PW[mode], n, hs, Y, PE, pt)
                     else:
                         errY2 = _rk_tangent(jacobian, mode, tau, C, S, hs, om, n, u, f0, k1, k2,
                                             k3, k4, k5, pp, mem, Y, W, KY, J, us, cmi, rtol,

@@ -106,20 +106,27 @@ def taylor_terms(PW, n, u, C, S, TW):
     """TW[j] = M^j z0 / j! (j = 0..N_TAYLOR) for z0 = (u, 1, C, S), from the matrices PW[j]
     = M^j / j! (``series_powers``). The sums read u, C and S, not TW[0]: a store into TW
     would otherwise order every later load of z0 behind it (the arrays may alias), about
-    twice the time."""
+    twice the time. The augmented rows are known in form: the constant's is 0 beyond j = 0
+    (M's row n is zero) and the forcing pair rotates, (C, S) -> (-om S, om C) / j, two terms of
+    PW each."""
     m = n + 3
     for i in range(n):
         TW[0, i] = u[i]
     TW[0, n] = 1.0
     TW[0, n + 1] = C
     TW[0, n + 2] = S
+    rc = (n + 1) * m
+    rs = (n + 2) * m
     for j in range(1, N_TAYLOR + 1):
-        for i in range(m):
+        for i in range(n):
             r = i * m
             acc = PW[j, r + n] + PW[j, r + n + 1] * C + PW[j, r + n + 2] * S
             for q in range(n):
                 acc += PW[j, r + q] * u[q]
             TW[j, i] = acc
+        TW[j, n] = 0.0
+        TW[j, n + 1] = PW[j, rc + n + 1] * C + PW[j, rc + n + 2] * S
+        TW[j, n + 2] = PW[j, rs + n + 1] * C + PW[j, rs + n + 2] * S
 
 
 @nb.njit(cache=True, inline="always", fastmath={"contract"})
@@ -242,23 +249,22 @@ def poly_x_extrema(TW, hs, xmax, xmin, cv):
 
 
 @nb.njit(cache=True, fastmath={"contract", "reassoc"})
-def poly_tangent(Mx, n, h, Y, t0, t1):
-    """Y[0:n] <- exp(A h) Y[0:n] (the homogeneous part; memory rows unchanged) by the same
-    series; t0, t1: work vectors of length n."""
+def poly_tangent(PW, n, h, Y, E, t):
+    """Y[0:n] <- exp(A h) Y[0:n] (the homogeneous part; memory rows unchanged): E = exp(A h) =
+    sum_j h^j PW[j][:n, :n] (the top-left block of M^j / j! is A^j / j!; ``pvalue`` per
+    entry), then each column multiplied by it; E (n x n) and t (n): work arrays."""
     m = n + 3
+    for a in range(n):
+        for b in range(n):
+            E[a, b] = pvalue(PW[:, a * m + b], h)
     for col in range(Y.shape[1]):
-        for i in range(n):
-            t0[i] = Y[i, col]
-        for j in range(1, N_TAYLOR + 1):
-            f = h / j
-            for i in range(n):
-                acc = 0.0
-                for q in range(n):
-                    acc += Mx[i * m + q] * t0[q]
-                t1[i] = acc * f
-            for i in range(n):
-                t0[i] = t1[i]
-                Y[i, col] += t1[i]
+        for a in range(n):
+            acc = 0.0
+            for b in range(n):
+                acc += E[a, b] * Y[b, col]
+            t[a] = acc
+        for a in range(n):
+            Y[a, col] = t[a]
 
 
 @nb.njit(cache=True)
