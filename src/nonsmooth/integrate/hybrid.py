@@ -154,7 +154,7 @@ def _stage_rotations(om, h):
     return c2, s2, c3, s3, c4, s4, c8, s8, c12, s12
 
 
-@nb.njit(cache=True, fastmath=_FM)
+@nb.njit(cache=True, inline="always", fastmath=_FM)
 def _rk_step(field, mode, tau, C, S, h, om, n, u, k0, pp, mem, rtol, atol, us, k1, k2, k3, k4,
              k5, u1):
     """One RKF45 step of length h from (tau, u) with field(mode) fixed; k0 = field at the start.
