@@ -130,29 +130,11 @@ def taylor_terms(PW, n, u, C, S, TW):
 
 
 @nb.njit(cache=True, inline="always", fastmath={"contract"})
-def pvalue(c, s):
-    """p(s) of the polynomial c of degree N_TAYLOR (any 1-d array, also a column of TW): Horner
-    in s^4 over the four residues of the exponent mod 4, four independent chains of
-    N_TAYLOR / 4 steps instead of one of N_TAYLOR (evaluation is latency-bound)."""
-    s2 = s * s
-    s4 = s2 * s2
-    a0 = c[N_TAYLOR]
-    a1 = 0.0
-    a2 = 0.0
-    a3 = 0.0
-    for k in range(N_TAYLOR // 4 - 1, -1, -1):
-        b = 4 * k
-        a0 = a0 * s4 + c[b]
-        a1 = a1 * s4 + c[b + 1]
-        a2 = a2 * s4 + c[b + 2]
-        a3 = a3 * s4 + c[b + 3]
-    return (a0 + s * a1) + s2 * (a2 + s * a3)
-
-
-@nb.njit(cache=True, inline="always", fastmath={"contract"})
 def pval(c, s):
-    """(p(s), p'(s)) of the polynomial c of degree N_TAYLOR (``pvalue``'s four chains, and four
-    more for p' = sum_i (i + 1) c[i + 1] s^i)."""
+    """(p(s), p'(s)) of the polynomial c of degree N_TAYLOR (any 1-d array, also a column of
+    TW): Horner in s^4 over the four residues of the exponent mod 4, four independent chains of
+    N_TAYLOR / 4 steps instead of one of N_TAYLOR (evaluation is latency-bound), and four more
+    for p' = sum_i (i + 1) c[i + 1] s^i."""
     s2 = s * s
     s4 = s2 * s2
     a0 = c[N_TAYLOR]
@@ -174,6 +156,12 @@ def pval(c, s):
         d2 = d2 * s4 + (b + 3) * c[b + 3]
         d3 = d3 * s4 + (b + 4) * c[b + 4]
     return (a0 + s * a1) + s2 * (a2 + s * a3), (d0 + s * d1) + s2 * (d2 + s * d3)
+
+
+@nb.njit(cache=True, inline="always", fastmath={"contract"})
+def pvalue(c, s):
+    """p(s) alone (``pval``, inlined: the derivative's chains are dead code there)."""
+    return pval(c, s)[0]
 
 
 @nb.njit(cache=True, inline="always")
