@@ -74,7 +74,8 @@ def kernel_source(model, method: str) -> str:
     src = src[:src.index("@nb.njit(GENERIC_KERNEL_SIGNATURE")]  # the pointer entry points
     for name in _INLINE:
         src, n = re.subn(r"@nb\.njit\(([^)]*)\)\ndef " + name + r"\(",
-                         lambda m: f"@nb.njit({m.group(1)}, inline=\"always\")\ndef {name}(",
+                         lambda m: (m.group(0) if "inline=" in m.group(1) else  # inlined already
+                                    f"@nb.njit({m.group(1)}, inline=\"always\")\ndef {name}("),
                          src)
         if n != 1:
             raise RuntimeError(f"specialise: no single definition of {name} in hybrid.py")

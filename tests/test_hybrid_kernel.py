@@ -541,7 +541,8 @@ def test_general_linear_modes_in_closed_form():
 def test_series_primitives_against_exact_arithmetic():
     """``linmodes``' evaluation primitives against oracles: ``pval`` / ``pvalue`` (Horner in
     s^4 over four residues) and the bound ``poly_m4`` against the same sums in exact rational
-    arithmetic, to a few ulp of the sum of the terms' magnitudes; ``taylor_terms`` from
+    arithmetic, to a few ulp of the sum of the terms' magnitudes, and each coefficient alone
+    exactly (random coefficients scaled as a series' hide the top orders); ``taylor_terms`` from
     ``series_powers`` (M^j / j! once per mode) summed at s against scipy's ``expm(M s) z0``,
     and ``poly_tangent`` against ``expm(A s)`` on the state rows of tangent vectors."""
     from fractions import Fraction
@@ -569,6 +570,12 @@ def test_series_primitives_against_exact_arithmetic():
         assert abs(d - float(der)) <= 8 * 2.0 ** -52 * dscale
         assert pvalue(c, s) == v
         assert abs(poly_m4(c, b) - float(m4)) <= 8 * 2.0 ** -52 * float(m4)
+    for j in range(N_TAYLOR + 1):  # each coefficient on its own, exactly (powers of 2)
+        e = np.zeros(N_TAYLOR + 1)
+        e[j] = 1.0
+        assert pval(e, 0.5) == (0.5 ** j, j * 0.5 ** (j - 1) if j else 0.0)
+        assert poly_m4(e, 0.5) == (j * (j - 1) * (j - 2) * (j - 3) * 0.5 ** (j - 4) if j >= 4
+                                   else 0.0)
     n, om = 3, 1.3
     A = rng.normal(size=(n, n))
     lin = np.concatenate([A.ravel(), rng.normal(size=3 * n)])
