@@ -580,10 +580,10 @@ def test_series_primitives_against_exact_arithmetic():
     A = rng.normal(size=(n, n))
     lin = np.concatenate([A.ravel(), rng.normal(size=3 * n)])
     m = n + 3
-    Mx = np.zeros(m * m)
-    rho = lin_matrix(lin, n, om, Mx)
     PW = np.zeros((N_TAYLOR + 1, m * m))
-    series_powers(Mx, m, PW)
+    rho = lin_matrix(lin, n, om, PW[1])
+    Mx = PW[1].copy()
+    series_powers(m, PW)
     u = rng.normal(size=n)
     C, S = math.cos(0.4), math.sin(0.4)
     TW = np.zeros((N_TAYLOR + 1, m))

@@ -453,10 +453,10 @@ def frame_omega(pp, opts):
 
 
 @nb.njit(cache=True)
-def _mode_class(linear, closed, mode, pp, lin, MC, mcs, om, MF, n, MX, MXR, PW):
+def _mode_class(linear, closed, mode, pp, lin, MC, mcs, om, MF, n, MXR, PW):
     """_MC_CLOSED / _MC_RK / _MC_RESONANT / _MC_POLY for ``mode``, filling the table row (and
-    the forcing amplitude ``MF[mode]``, or the augmented matrix ``MX[mode]``, its rate
-    ``MXR[mode]`` and its series' matrices ``PW[mode]``) lazily."""
+    the forcing amplitude ``MF[mode]``, or the series' matrices M^j / j! ``PW[mode]`` of the
+    augmented matrix M and its rate ``MXR[mode]``) lazily."""
     if not closed:
         return _MC_RK
     if mcs[mode] == _MC_UNKNOWN:
@@ -469,8 +469,8 @@ def _mode_class(linear, closed, mode, pp, lin, MC, mcs, om, MF, n, MX, MXR, PW):
             else:
                 mcs[mode] = _MC_RESONANT
         elif r == 2:
-            MXR[mode] = lin_matrix(lin, n, om, MX[mode])
-            series_powers(MX[mode], n + 3, PW[mode])
+            MXR[mode] = lin_matrix(lin, n, om, PW[mode, 1])
+            series_powers(n + 3, PW[mode])
             mcs[mode] = _MC_POLY
     return int(mcs[mode])
 
@@ -1097,7 +1097,7 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
     sizes = (len(p), 10 * n, nme, MAX_GUARDS * (n + 3), MAX_MODES * (N_MC + 7), nlin,
              N_BD * (1 + MAX_GUARDS), (SCAN_DEPTH + 1) * 5, _NS * nt * mt, 6 * nt + nt * nj,
              2 * nme if tan else 0, len(cmi), mt, n + 1,
-             MAX_MODES * (m3 * m3 + 1) + (N_TAYLOR + 1) * (m3 + 1) + n * n + n)
+             MAX_MODES + (N_TAYLOR + 1) * (m3 + 1) + n * n + n)
     total = 0
     for z in sizes:
         total += z
@@ -1147,9 +1147,7 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
     o += mt
     gr = view(ws, o, (n + 1,))  # gradient of a curved guard
     o += n + 1
-    MX = view(ws, o, (MAX_MODES, m3 * m3))  # augmented matrix of each _MC_POLY mode
-    o += MAX_MODES * m3 * m3
-    MXR = view(ws, o, (MAX_MODES,))  # its rate rho (a full piece is THETA_POLY / rho)
+    MXR = view(ws, o, (MAX_MODES,))  # rate rho of each _MC_POLY mode (piece: THETA_POLY / rho)
     o += MAX_MODES
     TW = view(ws, o, (N_TAYLOR + 1, m3))  # the Taylor terms of the current piece
     o += (N_TAYLOR + 1) * m3
@@ -1223,7 +1221,7 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
         sgn = _section_side(G, ng, H, n, u, f0, C0, S0, om)
         ksec = ng
         ng += 1
-    cls = _mode_class(linear, closed, mode, pp, lin, MC, mcs, om, MF, n, MX, MXR, PW)
+    cls = _mode_class(linear, closed, mode, pp, lin, MC, mcs, om, MF, n, MXR, PW)
     if cls == _MC_RESONANT:
         _store(state, u, n, mem, nmem, mode, h)
         keep_alive(ws)
@@ -1552,7 +1550,7 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
                         break
                     ksec = ng
                     ng += 1
-                cls = _mode_class(linear, closed, mode, pp, lin, MC, mcs, om, MF, n, MX, MXR, PW)
+                cls = _mode_class(linear, closed, mode, pp, lin, MC, mcs, om, MF, n, MXR, PW)
                 if cls == _MC_RESONANT:
                     code = st.RESONANCE
                     break

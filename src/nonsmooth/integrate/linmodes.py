@@ -81,23 +81,23 @@ def lin_matrix(lin, n, om, Mx):
 
 
 @nb.njit(cache=True, fastmath={"contract", "reassoc"})
-def series_powers(Mx, m, PW):
-    """PW[j] = M^j / j! (j = 0..N_TAYLOR; each m x m, row-major in the flat PW[j]): the
-    series' matrices of a mode, computed once per mode and call (``taylor_terms`` then costs
-    one product with z0 per term, independent of each other, instead of a chain of N_TAYLOR
-    products each waiting for the last)."""
+def series_powers(m, PW):
+    """PW[j] = M^j / j! (j = 0..N_TAYLOR; each m x m, row-major in the flat PW[j]) from
+    PW[1] = M (``lin_matrix`` writes it there): the series' matrices of a mode, computed once
+    per mode and call (``taylor_terms`` then costs one product with z0 per term, independent
+    of each other, instead of a chain of N_TAYLOR products each waiting for the last)."""
     mm = m * m
     for i in range(mm):
         PW[0, i] = 0.0
     for i in range(m):
         PW[0, i * m + i] = 1.0
-    for j in range(1, N_TAYLOR + 1):
+    for j in range(2, N_TAYLOR + 1):
         inv = 1.0 / j
         for i in range(m):
             for q in range(m):
                 acc = 0.0
                 for r in range(m):
-                    acc += Mx[i * m + r] * PW[j - 1, r * m + q]
+                    acc += PW[1, i * m + r] * PW[j - 1, r * m + q]
                 PW[j, i * m + q] = acc * inv
 
 
