@@ -516,7 +516,7 @@ def compile_method(model: Model, method: str) -> tuple:
         for part, sig in zip(parts, MODEL_SIGNATURES):
             fn = getattr(m, part) or (_no_curved if part == "curved" else _no_linear)
             try:
-                fns.append(nb.cfunc(sig, cache=True)(fn))
+                fns.append(nb.cfunc(sig, cache=True, error_model="numpy")(fn))
             except Exception as exc:
                 raise ParameterError(f"model {model.name}: {method}.{part} "
                                      f"({getattr(fn, '__name__', part)}) does not compile with "
