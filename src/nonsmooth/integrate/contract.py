@@ -110,8 +110,8 @@ class CompiledFunction:
     address protocol): numba would otherwise ask LLVM for the address of every function on
     every call from Python. ``jit_address`` is the native function behind the C wrapper:
     compiled code calls a first-class function there when it has one (numba's calling
-    convention, no C wrapper between: 1.1-1.5x on the generic kernel's RKF45 steps), which
-    numba looks up by ``_get_jit_address`` for its own dispatchers only (extended here).
+    convention, no C wrapper rebuilding the arrays between), which numba looks up by
+    ``_get_jit_address`` for its own dispatchers only (extended here).
     A model function must not raise (its cfunc is compiled with ``error_model="numpy"``):
     an exception would end the kernel early."""
 
