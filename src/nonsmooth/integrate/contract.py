@@ -134,7 +134,9 @@ def _register_jit_address():
     one); give a :class:`CompiledFunction`'s."""
     from numba.experimental import function_type
 
-    numba_lookup = function_type._get_jit_address
+    numba_lookup = getattr(function_type, "_get_jit_address", None)
+    if numba_lookup is None:  # another numba: its C wrappers are called, as before
+        return
 
     def _get_jit_address(func, sig):
         addr = getattr(func, "jit_address", 0) if isinstance(func, CompiledFunction) else 0
