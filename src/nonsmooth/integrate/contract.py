@@ -139,8 +139,9 @@ def _register_jit_address():
         return
 
     def _get_jit_address(func, sig):
-        addr = getattr(func, "jit_address", 0) if isinstance(func, CompiledFunction) else 0
-        return addr if addr > 0 else numba_lookup(func, sig)
+        if isinstance(func, CompiledFunction) and func.jit_address > 0:
+            return func.jit_address
+        return numba_lookup(func, sig)
     function_type._get_jit_address = _get_jit_address
 
 
