@@ -456,3 +456,61 @@ def test_fold_of_cycles_followed_in_two_parameters_against_the_closed_form():
     assert np.allclose(curve.mu.values[:, 0], -nus**2 / 4, atol=1e-8, rtol=0)
     assert np.all(np.isnan(curve.mu.values[:, 1:]))  # one fold per branch
     assert np.allclose(curve.multiplier_real.values[:, 0], 1.0, atol=1e-4)
+
+
+def test_stribeck_cycle_branch_turns_at_its_sliding_bifurcation_against_scipy():
+    """v_s = 0.5, xi = 0.68 along the belt speed: the stable stick-slip cycle's stick phase
+    shrinks to nothing and the branch turns back onto the unstable slip cycle born at the
+    subcritical Hopf point of steady sliding (a sliding bifurcation: a non-smooth fold, the
+    multiplier jumps from 0 to about 1.08). Checked against scipy's DOP853 on the slip field:
+    at the located corner the slip cycle closes and just touches the belt's speed; the points
+    after it are closed slip orbits that never reach it; the branch ends on steady sliding at
+    the Hopf point xi = (mu_s - mu_k)/v_s exp(-v_belt/v_s), period 2 pi / omega0."""
+    from scipy.integrate import solve_ivp
+    from scipy.optimize import minimize_scalar
+    p = M.params(v_s=0.5, xi=0.68)
+    x_eq = float(ns.equilibria(p).X[0])
+    br = ns.continuation(p, "v_belt", section="V", x0=x_eq, v0=1.0, step=0.01,
+                         bounds=(0.1, 0.5))
+    assert br.attrs["status"].startswith("the cycle shrinks onto an equilibrium")
+    fold = np.flatnonzero(br.special_type.values == 1)
+    assert len(fold) == 1 and int(br.special_jump[fold[0]]) == 1
+    after = int(br.special_after_point[fold[0]])
+    mu = br.multiplier_abs.values[:, 0]
+    assert np.all(mu[:after + 1] < 1e-9) and np.all(br.contact_fraction[:after - 1] > 0)
+    assert np.all(mu[after + 1:] > 1.0) and np.all(br.contact_fraction[after + 1:] == 0)
+    lam = br.v_belt.values
+    assert np.all(np.diff(lam[:after + 1]) > 0) and np.all(np.diff(lam[after + 1:]) < 0)
+
+    def slip_orbit(v_belt, x):
+        """The slip field (v_rel < 0 throughout) from (x, 0) to its next V = 0, decreasing:
+        (the return X, the largest V on the way)."""
+        q = p.replace(v_belt=v_belt)
+
+        def rhs(t, u):
+            return [u[1], -q.omega0**2 * u[0] - q.xi * u[1] + q.mu_k
+                    + (q.mu_s - q.mu_k) * math.exp((u[1] - v_belt) / q.v_s)]
+
+        def back(t, u):
+            return u[1]
+        back.terminal, back.direction = True, -1
+        a = solve_ivp(rhs, (0.0, 1.0), [x, 0.0], method="DOP853", rtol=1e-12, atol=1e-13)
+        b = solve_ivp(rhs, (1.0, 20.0), a.y[:, -1], method="DOP853", rtol=1e-12, atol=1e-13,
+                      events=back, dense_output=True)
+        ts = np.linspace(1.0, b.t[-1], 4001)
+        i = int(np.argmax(b.sol(ts)[1]))
+        top = minimize_scalar(lambda t: -b.sol(t)[1], bounds=(ts[max(i - 1, 0)],
+                              ts[min(i + 1, 4000)]), method="bounded",
+                              options=dict(xatol=1e-12))
+        return float(b.y_events[0][0][0]), float(b.sol(top.x)[1])
+
+    x_ret, v_top = slip_orbit(float(br.special_v_belt[fold[0]]),
+                              float(br.special_X_section[fold[0]]))
+    assert x_ret == pytest.approx(float(br.special_X_section[fold[0]]), abs=1e-9)
+    assert v_top == pytest.approx(float(br.special_v_belt[fold[0]]), abs=1e-8)  # touches
+    for i in (after + 2, len(lam) - 2):
+        x_ret, v_top = slip_orbit(lam[i], float(br.X_section[i, 0]))
+        assert x_ret == pytest.approx(float(br.X_section[i, 0]), abs=1e-9)
+        assert v_top < lam[i] - 1e-4
+    hopf = math.log((p.mu_s - p.mu_k) / (p.v_s * p.xi)) * p.v_s  # stribeck_slope = xi
+    assert abs(lam[-1] - hopf) < 1e-4 and abs(float(br.period[-1]) - 2 * math.pi) < 1e-3

@@ -473,7 +473,7 @@ def limit_cycle(params, section="V", *, x0: float = 0.0, v0: float = 0.0, u0=Non
         if not miss <= CONFIRM_TOL * (1.0 + float(np.linalg.norm(z))):
             status, converged = f"not confirmed: integrated again, the cycle misses its start " \
                                 f"by {miss:.3g}", False
-        U, R, mx, mn = _sample_cycle(params, solver, s, period, samples)
+        U, R, mx, mn, _ = _sample_cycle(params, solver, s, period, samples)
     absmu = np.abs(mu)
     stable = bool(converged and absmu.size and np.all(absmu < 1.0 - 1e-6))
     t = np.arange(samples) * (period / samples) if converged else np.full(samples, np.nan)
@@ -513,7 +513,7 @@ def limit_cycle(params, section="V", *, x0: float = 0.0, v0: float = 0.0, u0=Non
 
 def _sample_cycle(params, solver, state, period, samples):
     """The cycle from ``state`` sampled at ``samples`` equal steps of its period: (U, modes,
-    max X, min X) (the kernel's output grid: intervals of T / per_period with T / per_period
+    max X, min X, bit mask of the modes visited) (the kernel's output grid: intervals of T / per_period with T / per_period
     a whole fraction of the cycle's period is not possible in general, so each sample is its
     own call from the previous one: autonomous, the time origin does not matter)."""
     from ..simulate import state_u
@@ -525,6 +525,7 @@ def _sample_cycle(params, solver, state, period, samples):
     s = state.copy()
     dt = period / samples
     mx, mn = -math.inf, math.inf
+    visited = 0
     from ..kernels import run
     for i in range(samples):
         U[i] = state_u(params.model, s)
@@ -540,7 +541,8 @@ def _sample_cycle(params, solver, state, period, samples):
             U[i:] = np.nan
             break
         mx, mn = max(mx, float(bufs[4][0])), min(mn, float(bufs[5][0]))
-    return U, R, mx, mn
+        visited |= int(bufs[3][0])
+    return U, R, mx, mn, visited
 
 
 def _newton_equilibrium(fns, mode, p, u, mem, tol=1e-12, max_iter=50):
@@ -934,6 +936,11 @@ def surface_basins(params, section="V", *, x=(-1.0, 1.0), v=(-1.0, 1.0), grid=20
     return apply_state_units(ds, params.model)
 
 
+#: status of a branch of cycles that ends on an equilibrium (the corrector's point is a cycle of
+#: no extent: the equilibrium on the section, a fixed point of the return map)
+_SHRUNK = "the cycle shrinks onto an equilibrium (a Hopf point ends the branch)"
+
+
 class _CycleBranch:
     """Limit cycles of a self-excited system as a branch for pseudo-arclength continuation
     (the interface of ``continuation._Branch``): a point is y = (w, lam), the cycle's section
@@ -1044,7 +1051,7 @@ class _CycleBranch:
         s0 = s0.copy()  # its mode classified (-1: left to the kernel) before it is sampled
         run(KERNEL_GENERIC, self.solver.fns, params.pack(), self.solver.opts(), s0, 1, 0, 0,
             *output_buffers(0))
-        _, R, mx, mn = _sample_cycle(params, self.solver, s0, period, _SAMPLES)
+        U, R, mx, mn, visited = _sample_cycle(params, self.solver, s0, period, _SAMPLES)
         cm = params.model.contact_modes
         contact = float(np.mean(((1 << R.astype(np.int64)) & cm) != 0)) if cm else 0.0
         ns_test = 1.0
@@ -1056,7 +1063,9 @@ class _CycleBranch:
                  NEIMARK_SACKER: float(np.real(ns_test)),
                  GRAZING: mx - self.level if self.level is not None else math.nan}
         return dict(mu=mu, max_X=mx, min_X=mn, contact=contact, tests=tests, period=period,
-                    section=(z[:1], z[1:2], z[None, :]))
+                    section=(z[:1], z[1:2], z[None, :]), modes=visited,
+                    end=_SHRUNK if np.ptp(U, axis=0).max() <= 1e-7 * (1.0 + np.abs(U).max())
+                    else None)
 
 
 def cycle_continuation(params, param: str, section="V", *, k: int = 1, x0: float = 0.0,

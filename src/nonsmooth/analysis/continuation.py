@@ -20,6 +20,11 @@ Illinois method on the arclength (each trial point corrected onto the branch):
 
 ``special_jump`` says when the multipliers jumped across a located point instead of passing
 through the unit circle (a non-smooth transition: the test function changed sign by a jump).
+
+Where the orbit starts or stops visiting a mode (a sliding bifurcation), the branch has a corner
+and the corrector fails along the old tangent at every step; :func:`_corner` finds the other
+side, locates the corner by bisection and records it as a fold (the parameter turns back) or a
+grazing, with ``special_jump`` = 1.
 """
 
 from __future__ import annotations
@@ -172,6 +177,7 @@ class _Branch:
         cm = self.setup.model.contact_modes
         contact = float(np.mean(((1 << R.astype(np.int64)) & cm) != 0)) if cm else 0.0
         mx = float(np.max(Xmax)) if code == st.OK else math.nan
+        visited = int(np.bitwise_or.reduce(Mk)) if code == st.OK else None
         mn = float(np.min(Xmin)) if code == st.OK else math.nan
         ns_test = 1.0  # prod_{i<j} (mu_i mu_j - 1): real; zero when a pair's product is 1
         for i in range(len(mu)):
@@ -183,7 +189,8 @@ class _Branch:
                  NEIMARK_SACKER: ns_test,
                  GRAZING: mx - self.level if self.level is not None else math.nan}
         sec = (bufs[0][:self.k], bufs[1][:self.k], bufs[6][:self.k])
-        return dict(mu=mu, max_X=mx, min_X=mn, contact=contact, tests=tests, section=sec)
+        return dict(mu=mu, max_X=mx, min_X=mn, contact=contact, tests=tests, section=sec,
+                    modes=visited)
 
 
 def continuation(params, param: str, *, start=None, k: int = 1, x0: float = 0.0,
@@ -331,20 +338,30 @@ def _follow(br, pts, t, step, max_step, max_points, lo, hi, relocate=None, bound
             if got is not None:
                 break
             ds *= 0.5
+        corner = None
         if got is None:
             moved = relocate(br, y0, t) if relocate is not None else None
             if moved is None:
-                status = f"cannot continue (the corrector fails even at step x {MIN_STEP:g})"
-                break
-            br, y0, t, got, ds, phase = moved
-            moves.append((len(pts) - 1, phase))
+                corner = _corner(br, y0, f0, t, step, 2.0 * ds)
+                if corner is None:
+                    status = f"cannot continue (the corrector fails even at step x {MIN_STEP:g})"
+                    break
+                got, ds, t1, sp = corner
+                specials.append((sp[0], len(pts) - 1, *sp[1:], phase))
+            else:
+                br, y0, t, got, ds, phase = moved
+                moves.append((len(pts) - 1, phase))
         y1, ev1, iters = got
-        t1 = br.tangent(ev1, t)
+        if corner is None:
+            t1 = br.tangent(ev1, t)
         f1 = br.features(y1, ev1, t1)
+        if f1.get("end"):  # the branch ends here (see the branch's ``features``)
+            status = f1["end"]
+            break
         f1["phase"] = phase
         for typ in (FOLD, PERIOD_DOUBLING, NEIMARK_SACKER, GRAZING):
             a, b = f0["tests"][typ], f1["tests"][typ]
-            if math.isfinite(a) and math.isfinite(b) and a * b < 0:
+            if corner is None and math.isfinite(a) and math.isfinite(b) and a * b < 0:
                 sp = _locate(br, typ, y0, t, ds, a, b)
                 if sp is not None and _confirmed(typ, sp[1]):
                     specials.append((typ, len(pts) - 1, *sp, phase))
@@ -358,6 +375,79 @@ def _follow(br, pts, t, step, max_step, max_points, lo, hi, relocate=None, bound
             break
         ds = min(max_step, ds * 1.5) if iters <= 3 else (ds * 0.5 if iters > 6 else ds)
     return br, specials, moves, status
+
+
+def _corner(br, y0, f0, t0, step, s_fail):
+    """Where the corrector fails at every step and the section cannot be moved, the branch may
+    have a corner: a point where the orbit starts or stops visiting a mode (a sliding
+    bifurcation: a stick phase shrinks to nothing), so the map's derivative jumps there and
+    the branch goes on in another direction, often back in the parameter (a non-smooth fold:
+    a stable stick-slip cycle meets an unstable slip cycle). The other side is sought by
+    correcting with one coordinate (or the parameter) held at y0's plus or minus ds, ds from
+    ``step`` down to ``step`` x MIN_STEP; a point counts if it leaves the line of the branch
+    (y0, t0) and the map's derivative there differs from y0's (a jump). The corner is then
+    located by bisection along t0 in (0, s_fail) (``s_fail``: a step at which the corrector
+    failed), a trial point being on y0's side where its derivative is nearer y0's than the
+    other side's, to LOCATE_TOL in arclength. A corner must change the set of modes the orbit
+    visits (``features``' ``modes``, y0's in ``f0``): an orbit that shrinks onto an equilibrium
+    (a Hopf point ends a branch of cycles) is no corner. Returns (corrected point on the other side, its
+    distance from y0, the tangent there, the special point (FOLD where the parameter turns
+    back, else GRAZING; lam, the multiplier nearest +1 (fold) or the largest of the other
+    side, y, jump = True, max X)), or None."""
+    N = br.N
+    if f0.get("modes") is None:
+        return None
+    ev0 = br.evaluate(y0[:N], y0[N])
+    if ev0 is None:
+        return None
+    d0 = ev0[1]
+    tol_d = JUMP_TOL * (1.0 + np.linalg.norm(d0))
+    found = None
+    ds = step
+    while found is None and ds >= step * MIN_STEP:
+        for i in range(N + 1):
+            for sg in (1.0, -1.0):
+                e = np.zeros(N + 1)
+                e[i] = sg
+                got = br.correct(y0 + ds * e, e, y0)
+                if got is None:
+                    continue
+                dy = got[0] - y0
+                off = dy - (dy @ t0) * t0
+                if (np.linalg.norm(off) > 0.1 * np.linalg.norm(dy)
+                        and np.linalg.norm(got[1][1] - d0) > tol_d):
+                    t1 = br.tangent(got[1], dy / np.linalg.norm(dy))
+                    f1 = br.features(got[0], got[1], t1)
+                    if f1.get("modes") not in (None, f0["modes"]):
+                        found = got
+                        break
+            if found is not None:
+                break
+        ds *= 0.25
+    if found is None:
+        return None
+    y1, ev1, _ = found
+    d1 = ev1[1]
+    dy = y1 - y0
+    lo, hi = 0.0, s_fail
+    y_lo, ev_lo = y0, ev0
+    for _ in range(60):
+        if hi - lo <= LOCATE_TOL * max(1.0, abs(y0[N])):
+            break
+        s = 0.5 * (lo + hi)
+        got = br.correct(y0 + s * t0, t0, y0)
+        if got is not None and (np.linalg.norm(got[1][1] - d0)
+                                < np.linalg.norm(got[1][1] - d1)):
+            lo, y_lo, ev_lo = s, got[0], got[1]
+        else:
+            hi = s
+    br.template = ev1[3]  # the next corrections start from the other side
+    f_lo = br.features(y_lo, ev_lo, t0)
+    mu = np.r_[f_lo["mu"], f1["mu"]]
+    typ = FOLD if t0[N] * t1[N] < 0 else GRAZING
+    m = mu[np.argmin(np.abs(mu - 1.0))] if typ == FOLD else mu[len(f_lo["mu"])]
+    return found, float(np.linalg.norm(dy)), t1, (typ, float(y_lo[N]), complex(m), y_lo, True,
+                                                 f_lo["max_X"])
 
 
 def branch_arguments(params, param, k, max_points, step, max_step, tol, direction, bounds,
