@@ -1603,11 +1603,13 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
 @nb.njit(GENERIC_KERNEL_SIGNATURE, cache=True, fastmath=_FM)
 def advance_generic(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out, M_out,
                     Xmax_out, Xmin_out):
-    """Kernel contract (see ``integrate.contract``) for a hybrid model given by ``fns``."""
+    """Kernel contract (see ``integrate.contract``) for a hybrid model given by ``fns``. It
+    calls ``_advance`` with exactly ``advance_tangent``'s argument types (``qr`` an int64, not
+    the literal 0), so numba compiles that body once for both kernels, not twice."""
     return _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out, M_out,
                     Xmax_out, Xmin_out, np.zeros((0, 0)), np.zeros((0, 0)),
-                    np.zeros(0, np.int64), 0, np.zeros((0, 0)), np.zeros(0), np.zeros(4),
-                    np.zeros((0, 0)), np.zeros(0))
+                    np.zeros(0, np.int64), np.int64(0), np.zeros((0, 0)), np.zeros(0),
+                    np.zeros(4), np.zeros((0, 0)), np.zeros(0))
 
 
 @nb.njit(TANGENT_KERNEL_SIGNATURE, cache=True, fastmath=_FM)
