@@ -514,3 +514,27 @@ def test_stribeck_cycle_branch_turns_at_its_sliding_bifurcation_against_scipy():
         assert v_top < lam[i] - 1e-4
     hopf = math.log((p.mu_s - p.mu_k) / (p.v_s * p.xi)) * p.v_s  # stribeck_slope = xi
     assert abs(lam[-1] - hopf) < 1e-4 and abs(float(br.period[-1]) - 2 * math.pi) < 1e-3
+
+
+def test_an_isola_of_cycles_is_followed_once_round_and_closes_against_the_closed_form():
+    """r' = r g, theta' = 1 with g = 1/4 - mu^2 - (s - 1)^2 (s = r^2): cycles on the circle
+    mu^2 + (s - 1)^2 = 1/4 (an isola: a closed branch with folds at mu = +-1/2, s = 1), period
+    2 pi, multiplier exp(-8 pi s (s - 1)). Continuation goes once round it, locates both folds
+    and stops where the branch comes back to its first point (status "closed loop")."""
+    m = ns.model_from_equations(
+        "isola_of_cycles", states=("X", "Y"), parameters={"mu": 0.0},
+        modes={"flow": ["X*(0.25 - mu**2 - (X**2 + Y**2 - 1)**2) - Y",
+                        "Y*(0.25 - mu**2 - (X**2 + Y**2 - 1)**2) + X"]}, omega=None)
+    br = ns.continuation(m.params(), "mu", section=("Y", "increasing"), x0=1.2, step=0.05,
+                         bounds=(-1.0, 1.0), max_points=400)
+    assert br.attrs["status"].startswith("closed loop")
+    mu, s = br.mu.values, br.X_section.values[:, 0] ** 2
+    assert np.allclose(mu**2 + (s - 1) ** 2, 0.25, atol=1e-9, rtol=0)
+    assert np.allclose(br.period.values, 2 * math.pi, atol=1e-9, rtol=0)
+    assert np.allclose(br.multiplier_real.values[:, 0], np.exp(-8 * math.pi * s * (s - 1)),
+                       rtol=1e-6, atol=1e-12)
+    # once round: both halves, every angle of the circle visited, none twice
+    ang = np.unwrap(np.arctan2(mu, s - 1))
+    assert 2 * math.pi - 0.5 < abs(ang[-1] - ang[0]) < 2 * math.pi + 0.5
+    assert list(br.special_type.values) == [1, 1]
+    assert np.allclose(np.sort(br.special_mu.values), [-0.5, 0.5], atol=1e-8)

@@ -217,7 +217,9 @@ def continuation(params, param: str, *, start=None, k: int = 1, x0: float = 0.0,
     away from the PD). The branch then runs ``direction`` ("up": ``param`` increasing
     at first, "down") with arclength steps starting at ``step`` (in the units of the
     parameter and the section point, adapted between step x MIN_STEP and ``max_step``, default
-    10 x step) until it leaves ``bounds`` (lo, hi), reaches ``max_points`` or cannot continue.
+    10 x step) until it leaves ``bounds`` (lo, hi), reaches ``max_points``, comes back to its
+    first point (a closed branch, an isola: status "closed loop") or cannot continue; it
+    turns at corners (a sliding bifurcation, :func:`_corner`).
     Where the corrector fails at every step, the section may sit on an event of the orbit (an
     impact at t = kT makes the map non-smooth): the section is then moved a quarter, a half or
     three quarters of a period on (``_moved_section``) and the branch goes on there; the
@@ -318,9 +320,11 @@ def _follow(br, pts, t, step, max_step, max_points, lo, hi, relocate=None, bound
     """Pseudo-arclength steps from the last of ``pts`` ((y, features) pairs; y = the branch's
     coordinates, then the parameter) along the unit tangent ``t``, appending each corrected
     point, until ``max_points``, the parameter leaves (lo, hi) (or coordinate i leaves
-    (lo2, hi2), ``bounds2`` = (i, lo2, hi2): status "left bounds2"), or the corrector fails even at
-    step x MIN_STEP and ``relocate(br, y, t)`` (if given) offers no way on (else it returns
-    (branch, y, t, corrected point, step, section phase)). The step adapts to the corrector's
+    (lo2, hi2), ``bounds2`` = (i, lo2, hi2): status "left bounds2"), the branch comes back to its
+    first point (:func:`_closes`: "closed loop"), a point's features end it (``end``), or the
+    corrector fails even at step x MIN_STEP and neither ``relocate(br, y, t)`` (if given:
+    it returns (branch, y, t, corrected point, step, section phase)) nor a corner
+    (:func:`_corner`) offers a way on. The step adapts to the corrector's
     iterations; sign changes of the test functions between points are located
     (:func:`_locate`). ``br`` has ``N`` (coordinates), ``correct``, ``tangent`` and
     ``features`` (see :class:`_Branch`). Returns (branch, specials, moves, status)."""
@@ -330,6 +334,7 @@ def _follow(br, pts, t, step, max_step, max_points, lo, hi, relocate=None, bound
     moves = []  # (point index, new section phase): where the section was moved off an event
     ds = step
     status = "max_points"
+    first, t_first, reach = pts[0][0], t.copy(), 0.0
     while len(pts) < max_points:
         y0, f0 = pts[-1]
         got = None
@@ -367,6 +372,10 @@ def _follow(br, pts, t, step, max_step, max_points, lo, hi, relocate=None, bound
                     specials.append((typ, len(pts) - 1, *sp, phase))
         pts.append((y1, f1))
         t = t1
+        reach = max(reach, float(np.linalg.norm(y0 - first)))
+        if not moves and _closes(y0, y1, first, t_first, reach):
+            status = "closed loop (the branch came back to its first point: an isola)"
+            break
         if not lo <= y1[N] <= hi:
             status = "left the bounds"
             break
@@ -375,6 +384,22 @@ def _follow(br, pts, t, step, max_step, max_points, lo, hi, relocate=None, bound
             break
         ds = min(max_step, ds * 1.5) if iters <= 3 else (ds * 0.5 if iters > 6 else ds)
     return br, specials, moves, status
+
+
+def _closes(y0, y1, first, t_first, reach):
+    """Does the step from y0 to y1 pass through the branch's first point ``first`` in the
+    direction the branch left it (``t_first``), after the branch went away from it (``reach``:
+    the largest distance of an earlier point from it, at least twice the step)? Then the branch
+    is a closed curve (an isola) and going on would trace it again. The first point must lie
+    between the chord's ends, within 25 % of its length of it (the arc bulges by about its
+    curvature x length^2 / 8)."""
+    d = y1 - y0
+    L2 = float(d @ d)
+    if L2 == 0.0 or float(d @ t_first) <= 0.0 or reach < 2.0 * math.sqrt(L2):
+        return False
+    s = float((first - y0) @ d) / L2
+    off = first - (y0 + s * d)
+    return -0.01 <= s <= 1.01 and float(np.linalg.norm(off)) <= 0.25 * math.sqrt(L2)
 
 
 def _corner(br, y0, f0, t0, step, s_fail):
