@@ -513,9 +513,10 @@ def limit_cycle(params, section="V", *, x0: float = 0.0, v0: float = 0.0, u0=Non
 
 def _sample_cycle(params, solver, state, period, samples):
     """The cycle from ``state`` sampled at ``samples`` equal steps of its period: (U, modes,
-    max X, min X, bit mask of the modes visited) (the kernel's output grid: intervals of T / per_period with T / per_period
-    a whole fraction of the cycle's period is not possible in general, so each sample is its
-    own call from the previous one: autonomous, the time origin does not matter)."""
+    max X, min X, bit mask of the modes visited) (the kernel's output grid: intervals of
+    T / per_period with T / per_period a whole fraction of the cycle's period is not possible
+    in general, so each sample is its own call from the previous one: autonomous, the time
+    origin does not matter)."""
     from ..simulate import state_u
     n = params.model.n
     U = np.empty((samples, n))

@@ -415,10 +415,10 @@ def _corner(br, y0, f0, t0, step, s_fail):
     failed), a trial point being on y0's side where its derivative is nearer y0's than the
     other side's, to LOCATE_TOL in arclength. A corner must change the set of modes the orbit
     visits (``features``' ``modes``, y0's in ``f0``): an orbit that shrinks onto an equilibrium
-    (a Hopf point ends a branch of cycles) is no corner. Returns (corrected point on the other side, its
-    distance from y0, the tangent there, the special point (FOLD where the parameter turns
-    back, else GRAZING; lam, the multiplier nearest +1 (fold) or the largest of the other
-    side, y, jump = True, max X)), or None."""
+    (a Hopf point ends a branch of cycles) is no corner. Returns (corrected point on the other
+    side, its distance from y0, the tangent there, the special point (FOLD where the parameter
+    turns back, else GRAZING; lam, the multiplier nearest +1 (fold) or the largest of the
+    other side, y, jump = True, max X)), or None."""
     N = br.N
     if f0.get("modes") is None:
         return None
