@@ -185,3 +185,17 @@ def test_stable_parts_agree_with_a_sweep(fig6a_branch):
                                     x0=float(br.X_section[i, 0]) + 1e-3,
                                     v0=float(br.V_section[i, 0]), lyapunov=False)
         assert float(sw.max_X[0, 0]) == pytest.approx(float(br.max_X[i]), abs=1e-6)
+
+
+def test_the_corrector_does_not_jump_to_another_branch():
+    """Forced Stribeck stick-slip in F0: a corrector that wandered 0.77 in F0 from a step of
+    0.045 landed on another branch (the point after F0 = 0.105 was at 0.871); now each point
+    lies within three steps (at most 3 x max_step = 0.6) of its prediction, so the branch is
+    a connected curve: no two neighbours farther apart than that."""
+    p = ns.model("stick_slip").preset("stribeck")
+    br = continuation(p, "F0", transient=200, method="exact", bounds=(0.0, 1.0), step=0.02,
+                      max_points=40)
+    y = np.c_[br.X_section.values[:, 0], br.V_section.values[:, 0], br.F0.values]
+    assert np.all(np.linalg.norm(np.diff(y, axis=0), axis=1) <= 0.6)
+    assert np.all(np.abs(np.diff(br.F0.values)) <= 0.2 + 1e-12)
+    assert br.sizes["point"] >= 20 and float(br.F0[-1]) > 1.0
