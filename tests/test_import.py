@@ -111,17 +111,72 @@ def test_source_digest_covers_the_kernels_only(tmp_path):
     shutil.copytree(src, tmp_path / "nonsmooth", ignore=shutil.ignore_patterns("__pycache__"))
     digest = ("import nonsmooth._numba_cache as c; "
               "assert c.ROOT == __import__('pathlib').Path(c.__file__).parent; "
-              "print(c.source_digest())")
+              "print(*(c.source_digest(k) for k in range(len(c.LAYERS))), c.source_digest())")
 
     def current():
-        return _python(digest, PYTHONPATH=str(tmp_path)).stdout.strip()
+        return _python(digest, PYTHONPATH=str(tmp_path)).stdout.split()
+
+    def edit(rel, text):
+        with open(tmp_path / "nonsmooth" / rel, "a") as f:
+            f.write(f"\n# {text}\n")
 
     d0 = current()
-    with open(tmp_path / "nonsmooth" / "plot" / "common.py", "a") as f:
-        f.write("\n# an edited label\n")
-    with open(tmp_path / "nonsmooth" / "cli" / "common.py", "a") as f:
-        f.write("\n# an edited help text\n")
+    assert len(d0) == 5 and d0[3] == d0[4]  # (the top layer's digest is the whole digest)
+    edit("plot/common.py", "an edited label")
+    edit("cli/common.py", "an edited help text")
     assert current() == d0
-    with open(tmp_path / "nonsmooth" / "integrate" / "record.py", "a") as f:
-        f.write("\n# an edited kernel\n")
-    assert current() != d0
+    # an edited analysis: its layer's stamp changes, the integrators' and models' do not
+    edit("analysis/stability.py", "an edited analysis")
+    d1 = current()
+    assert d1[:3] == d0[:3] and d1[3] != d0[3]
+    # an edited integrator: every stamp changes
+    edit("integrate/record.py", "an edited kernel")
+    d2 = current()
+    assert all(a != b for a, b in zip(d2, d1))
+
+
+def _module_file(root, parts):
+    """The file of module ``nonsmooth.<parts>`` (a module or a package's __init__), or None."""
+    path = root.joinpath(*parts)
+    if path.with_suffix(".py").is_file():
+        return path.with_suffix(".py").resolve()
+    if (path / "__init__.py").is_file():
+        return (path / "__init__.py").resolve()
+    return None
+
+
+def test_kernel_layers_import_only_from_their_own_layer_and_below():
+    # a cached function is stamped with the digest of its layer and the layers below
+    # (``_numba_cache.LAYERS``): its compiled code must not contain code from a layer above,
+    # so no kernel module imports from one (at any depth: also imports inside functions)
+    import ast
+
+    from nonsmooth import _numba_cache as c
+    layers = c._kernel_set()
+    assert set(layers) == {p.resolve() for p in c.kernel_source_files()}
+    bad = []
+    for path, k in layers.items():
+        pkg = list(path.parent.relative_to(c.ROOT).parts)
+        for node in ast.walk(ast.parse(path.read_text())):
+            if isinstance(node, ast.ImportFrom):
+                if node.level == 0:
+                    if not (node.module or "").split(".")[0] == "nonsmooth":
+                        continue
+                    parts = node.module.split(".")[1:]
+                else:
+                    parts = pkg[:len(pkg) - (node.level - 1)] + (
+                        node.module.split(".") if node.module else [])
+                targets = [parts + [a.name] for a in node.names] + [parts]
+            elif isinstance(node, ast.Import):
+                targets = [a.name.split(".")[1:] for a in node.names
+                           if a.name.split(".")[0] == "nonsmooth"]
+            else:
+                continue
+            for t in targets:
+                f = _module_file(c.ROOT, t)
+                if f is not None and layers.get(f, -1) > k:
+                    bad.append(f"{path.relative_to(c.ROOT)} (layer {k}) imports "
+                               f"{f.relative_to(c.ROOT)} (layer {layers[f]})")
+    assert not bad, "\n".join(bad)
+    # the check sees imports at all: integrate/hybrid.py imports status, layer 0
+    assert layers[c.ROOT / "status.py"] == 0

@@ -4,8 +4,16 @@ Numba keys a cached function on the file that defines it, not on the compiled fu
 calls: after an edit to a kernel, a cached caller (the method dispatcher, a sweep) would keep
 running the old kernel. This module registers a cache *locator* that applies only to functions
 defined in this package's compiled modules (``KERNEL_SOURCES``): their cache entries are stamped
-with a digest of all those sources, so an edit to any of them invalidates every cached kernel,
-and an edit elsewhere (a plot label, the CLI, the reproduction report) invalidates nothing.
+with a digest of those sources, so an edit to a kernel invalidates every cached function that
+may contain its code, and an edit elsewhere (a plot label, the CLI, the reproduction report)
+invalidates nothing.
+
+The sources come in layers (``LAYERS``, lowest first): the integrators, the models, the
+kernels' dispatch and sweeps, the analyses. Compiled code of one layer calls (and so may
+contain) code of its own layer and of the layers below, never above (``tests/test_import.py``
+checks every module's imports), so a function's entries are stamped with the digest of its
+own layer and those below: an edit to an analysis does not recompile the integrators (about
+two minutes on an empty cache), an edit to an integrator recompiles everything.
 
 Nothing else in the process is affected: other numba libraries keep numba's own locators and
 ``numba.config.CACHE_DIR``. The cache lives in ``$NUMBA_CACHE_DIR/nonsmooth`` when the user set
@@ -22,32 +30,47 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent
 
-#: Sources whose compiled code (or constants read by compiled code) the kernels depend on:
-#: every package module with numba code must be listed here (a test checks it).
-KERNEL_SOURCES = ("integrate", "models", "analysis", "kernels.py", "sweep.py", "status.py")
+#: Sources whose compiled code (or constants read by compiled code) the kernels depend on, in
+#: layers, lowest first: a module may import from its own layer and the layers below only.
+#: Every package module with numba code must be listed here.
+LAYERS = (("integrate", "status.py"), ("models",), ("kernels.py", "sweep.py"), ("analysis",))
+KERNEL_SOURCES = tuple(entry for layer in LAYERS for entry in layer)
+#: The layer whose digest stamps the numba functions of users' model files (they may call the
+#: models' compiled helpers, nothing above).
+USER_LAYER = 1
 
-_digest: str | None = None
+_digests: dict = {}
 _base: Path | None = None
 
 
-def kernel_source_files() -> list[Path]:
+def _files(entries) -> list[Path]:
     files = []
-    for entry in KERNEL_SOURCES:
+    for entry in entries:
         path = ROOT / entry
         files.extend(sorted(path.rglob("*.py")) if path.is_dir() else [path])
     return files
 
 
-def source_digest() -> str:
-    """sha256 (16 hex digits) of the kernel sources' paths and contents (computed once)."""
-    global _digest
-    if _digest is None:
+def kernel_source_files() -> list[Path]:
+    return _files(KERNEL_SOURCES)
+
+
+def layer_of(path: Path) -> int | None:
+    """The layer (index into ``LAYERS``) of the package file ``path``, or None."""
+    return _kernel_set().get(Path(path).resolve())
+
+
+def source_digest(layer: int | None = None) -> str:
+    """sha256 (16 hex digits) of the paths and contents of the kernel sources of ``layer`` and
+    the layers below (None: all of them); computed once per layer."""
+    top = len(LAYERS) - 1 if layer is None else layer
+    if top not in _digests:
         h = hashlib.sha256()
-        for path in kernel_source_files():
+        for path in _files(e for lay in LAYERS[:top + 1] for e in lay):
             h.update(str(path.relative_to(ROOT)).encode())
             h.update(path.read_bytes())
-        _digest = h.hexdigest()[:16]
-    return _digest
+        _digests[top] = h.hexdigest()[:16]
+    return _digests[top]
 
 
 def cache_base() -> Path | None:
@@ -80,16 +103,17 @@ def is_compiled(module: str) -> bool:
     path = ROOT.joinpath(*module.split(".")).with_suffix(".py")
     sub = base / _subpath(path)
     stem = path.stem
+    digest = source_digest(layer_of(path)).encode()
     try:
-        return any(_index_is_current(p) for p in sub.glob(f"{stem}.*.nbi"))
+        return any(_index_is_current(p, digest) for p in sub.glob(f"{stem}.*.nbi"))
     except OSError:
         return False
 
 
-def _index_is_current(index: Path) -> bool:
+def _index_is_current(index: Path, digest: bytes) -> bool:
     # the index starts with the pickled source stamp; a stale one names another digest
     try:
-        return source_digest().encode() in index.read_bytes()[:256]
+        return digest in index.read_bytes()[:256]
     except OSError:
         return False
 
@@ -121,10 +145,11 @@ def _locator_class():
         """Cache locator for this package's kernels and the users' model files (see module
         docstring and ``register_user_file``)."""
 
-        def __init__(self, py_func, py_file, user=None):
+        def __init__(self, py_func, py_file, user=None, layer=None):
             self._py_file = py_file
             self._lineno = py_func.__code__.co_firstlineno
             self._user = user
+            self._layer = USER_LAYER if user else layer
             self._cache_path = str(cache_base() / ("user/" + user if user else
                                                    _subpath(Path(py_file))))
 
@@ -132,8 +157,8 @@ def _locator_class():
             return self._cache_path
 
         def get_source_stamp(self):
-            return "nonsmooth-kernels-" + source_digest() + (f"-{self._user}" if self._user
-                                                             else "")
+            return "nonsmooth-kernels-" + source_digest(self._layer) + (
+                f"-{self._user}" if self._user else "")
 
         def get_disambiguator(self):
             return str(self._lineno)
@@ -145,9 +170,10 @@ def _locator_class():
             except (OSError, TypeError):
                 return None
             user = user_modules.get(path)
-            if cache_base() is None or (user is None and path not in _kernel_set()):
+            layer = _kernel_set().get(path)
+            if cache_base() is None or (user is None and layer is None):
                 return None
-            self = cls(py_func, py_file, user)
+            self = cls(py_func, py_file, user, layer)
             try:
                 self.ensure_cache_path()
             except OSError:
@@ -157,13 +183,14 @@ def _locator_class():
     return KernelCacheLocator
 
 
-_kernel_files: frozenset | None = None
+_kernel_files: dict | None = None
 
 
-def _kernel_set() -> frozenset:
+def _kernel_set() -> dict:
+    """Resolved path of every kernel source -> its layer."""
     global _kernel_files
     if _kernel_files is None:
-        _kernel_files = frozenset(p.resolve() for p in kernel_source_files())
+        _kernel_files = {p.resolve(): k for k, layer in enumerate(LAYERS) for p in _files(layer)}
     return _kernel_files
 
 
