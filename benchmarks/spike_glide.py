@@ -53,9 +53,7 @@ def worker(models: list[str]) -> None:
         m = model(name)
         params = m.preset(arg) if how == "preset" else m.params(**arg)
         for method in ("smooth", "exact"):
-            t0 = time.perf_counter()
             solver = kernels.Solver(model=m, method=method)
-            load = time.perf_counter() - t0
             p, code, fns, o = params.pack(), solver.code, solver.fns, solver.opts()
 
             def go(periods):
@@ -70,7 +68,7 @@ def worker(models: list[str]) -> None:
                                  + st.tobytes()).hexdigest()[:16]
             best = min(go(3000)[0] for _ in range(3))
             out.append(dict(case=f"{name} {arg if how == 'preset' else 'params'} {method}",
-                            status=int(status), sha=sha, rate=3000 / best, load=load))
+                            status=int(status), sha=sha, rate=3000 / best))
     print(json.dumps(out))
 
 

@@ -1,5 +1,6 @@
 """Where a model's time per period goes: its rate (periods/s), its steps per forcing period and
-the cost of one step, on the generic kernel, one trajectory from rest.
+the cost of one step, on the generic kernel, one trajectory from rest, for the cases of
+``bench_models.py`` (a second case of a model is named ``name#2``).
 
 Steps per period: the smallest ``max_steps`` (``Solver.opts()[OPT_MAX_STEPS]``, the steps a
 call allows per period on average) with which 400 periods finish, found by bisection; it counts
@@ -17,22 +18,20 @@ from __future__ import annotations
 import argparse
 import time
 
+from bench_models import CASES
+
 from nonsmooth import kernels
 from nonsmooth.integrate.contract import OPT_ATOL, OPT_MAX_STEPS, OPT_RTOL
 from nonsmooth.models import model
 
-CASES = {"two_sided": lambda m: m.preset("table3"),
-         "impact": lambda m: m.params(F0=0.5, omega=0.8, r=0.8),
-         "stick_slip": lambda m: m.params(),
-         "bouncing_ball": lambda m: m.preset("period_one"),
-         "impact_2dof": lambda m: m.params(),
-         "jeffcott_rotor": lambda m: m.preset("partial_rub")}
+#: ``bench_models``' models on the generic kernel (``support`` runs its own kernels)
+GENERIC = tuple(dict.fromkeys(name for name, _make, _note in CASES if name != "support"))
 
 
-def measure(name: str, method: str, rtol: float | None) -> tuple[float, int]:
+def measure(name: str, make, method: str, rtol: float | None) -> tuple[float, int]:
     m = model(name)
     solver = kernels.Solver(model=m, method=method)
-    p = CASES[name](m).pack()
+    p = make(m).pack()
     opts = solver.opts()
     if rtol is not None:
         opts[OPT_RTOL], opts[OPT_ATOL] = rtol, rtol * 1e-2
@@ -60,18 +59,23 @@ def measure(name: str, method: str, rtol: float | None) -> tuple[float, int]:
 
 def main(argv=None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--models", default=",".join(CASES))
+    ap.add_argument("--models", default=",".join(GENERIC))
     ap.add_argument("--methods", default="exact,smooth")
     ap.add_argument("--rtol", default="", help="comma-separated tolerances (default: the method's)")
     a = ap.parse_args(argv)
     rtols = [float(r) for r in a.rtol.split(",") if r] or [None]
     print(f"{'model':15s} {'method':6s} {'rtol':>7s} {'periods/s':>10s} {'steps/period':>12s} "
           f"{'us/step':>8s}")
-    for name in a.models.split(","):
+    seen: dict = {}
+    for name, make, _note in CASES:
+        if name not in a.models.split(","):
+            continue
+        seen[name] = seen.get(name, 0) + 1  # a model's second case of bench_models: name#2
+        label = name if seen[name] == 1 else f"{name}#{seen[name]}"
         for method in a.methods.split(","):
             for rtol in rtols:
-                rate, steps = measure(name, method, rtol)
-                print(f"{name:15s} {method:6s} {rtol or 'method':>7} {rate:10.4g} {steps:12d} "
+                rate, steps = measure(name, make, method, rtol)
+                print(f"{label:15s} {method:6s} {rtol or 'method':>7} {rate:10.4g} {steps:12d} "
                       f"{1e6 / rate / steps:8.3f}", flush=True)
 
 

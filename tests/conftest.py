@@ -9,10 +9,6 @@ import sys
 #: (the kernels take 1-2 GB while compiling), and the compiled sweeps use every core anyway.
 MAX_WORKERS = 4
 
-#: Modules whose first compile takes minutes (``_numba_cache.SLOW_MODULES`` less ``kernels``,
-#: which imports them): compiled before the workers start, each in a process of its own.
-_WARM = ("integrate.hybrid", "models.support.smooth_kernel", "models.support.exact_kernel")
-
 
 def pytest_xdist_auto_num_workers(config):
     return max(1, min(MAX_WORKERS, os.cpu_count() or 1))
@@ -25,7 +21,9 @@ def pytest_configure(config):
     if hasattr(config, "workerinput") or not getattr(config.option, "numprocesses", None):
         return
     from nonsmooth import _numba_cache
-    todo = [m for m in _WARM if not _numba_cache.is_compiled(m)]
+    # the modules whose first compile takes minutes, less ``kernels``, which imports them
+    todo = [m for m in _numba_cache.SLOW_MODULES
+            if m != "kernels" and not _numba_cache.is_compiled(m)]
     procs = [subprocess.Popen([sys.executable, "-c", f"import nonsmooth.{m}"]) for m in todo]
     for p in procs:
         p.wait()
