@@ -141,6 +141,30 @@ def test_certified_lattice_cells_keep_labels_and_determinism():
     slow = basins(p, grid=64, method="exact", early_stop=False)
     np.testing.assert_array_equal(fast.label.values, slow.label.values)
     assert fast.periods_used.mean() < 0.2 * slow.periods_used.mean()
+    # the same grid with the axes swapped runs with every component: balls in the whole state
+    # space (here a circle sampled by a square's boundary, margin its longest image edge)
+    swap = basins(p, grid=64, method="exact", axes=("V", "X"))
+    np.testing.assert_array_equal(swap.label.values, fast.label.values.T)
+    assert swap.attrs["certified_cells"] > 0 and (swap.capture_radius > 0).all()
+    assert swap.periods_used.mean() < 0.2 * slow.periods_used.mean()
+
+
+def test_the_sampled_sphere_of_a_ball_is_covered_by_its_edges():
+    """The samples of S^(n-1) (the cube's boundary grid) and their neighbour edges: every
+    direction lies nearer a sample than the longest edge (so the margin of a ball's image,
+    its longest image edge, covers the points between the samples, to first order)."""
+    from nonsmooth.analysis.basins.certify import _BALL_K, _CELL_K, sphere
+    rng = np.random.default_rng(1)
+    for n, k in list(_BALL_K.items()) + list(_CELL_K.items()):
+        W, E = sphere(n, k)
+        assert len(W) == (k + 1) ** n - (k - 1) ** n
+        np.testing.assert_allclose(np.linalg.norm(W, axis=1), 1.0, rtol=1e-15)
+        assert set(np.unique(E)) == set(range(len(W)))  # every sample has neighbours
+        edge = np.linalg.norm(W[E[:, 0]] - W[E[:, 1]], axis=1).max()
+        d = rng.normal(size=(20000, n))
+        d /= np.linalg.norm(d, axis=1)[:, None]
+        near = np.sqrt(np.maximum(0, 2 - 2 * (d @ W.T).max(axis=1))).max()
+        assert near < 0.75 * edge, (n, k, near, edge)
 
 
 @pytest.mark.parametrize("kwargs, field", [

@@ -214,9 +214,10 @@ def test_x_and_v_quantities_carry_the_models_units():
 
 
 def test_basins_on_any_two_components_against_single_runs(tmp_path, capsys):
-    """Basins on the grid (X, Y) with V = W = 0 (a four-state model: no certificate, every point
-    runs until its section repeats): each grid point's label is the attractor that
-    ``poincare`` reaches from the same full start, and the axes are named in the result."""
+    """Basins on the grid (X, Y) with V = W = 0 (the exact method merges trajectories in
+    sticking: no certificate, every point runs until its section repeats): each grid point's
+    label is the attractor that ``poincare`` reaches from the same full start, and the axes
+    are named in the result."""
     ds = ns.basins(P, x=(-0.6, 0.4), v=(-0.8, 0.8), grid=3, method="exact", axes=("X", "Y"),
                    max_periods=2000)
     assert ds.attrs["axes"] == "X Y" and ds.v0.attrs["long_name"] == "initial Y"
@@ -239,3 +240,21 @@ def test_basins_on_any_two_components_against_single_runs(tmp_path, capsys):
                             str(tmp_path / "c.nc")], capsys)
     assert code == 2
     one_line(err, "axes: unknown component 'Q'")
+
+
+def test_basins_certify_balls_in_the_four_dimensional_state_space():
+    """The smooth method's flow is a homeomorphism: on a grid of 64 x 64 points in (X, Y) the
+    capture balls and lattice cells are certified in the whole state space (X, V, Y, W). Far
+    from the stop (delta = 5) the model is linear with one attractor, the forced response, so
+    every label is known; nearly every point is decided at once instead of running ~130
+    periods until its section repeats. A 16 x 16 grid certifies nothing (it would not pay)."""
+    p = ns.model("impact_2dof").params(delta=5.0, k_c=100.0)
+    ds = ns.basins(p, x=(-1, 1), v=(-1, 1), grid=64, method="smooth", axes=("X", "Y"),
+                   lyapunov=False)
+    assert ds.sizes["attractor"] == 1 and (ds.label.values == 0).all()
+    assert float(ds.capture_radius[0, 0]) > 0.5
+    assert ds.attrs["certified_cells"] == ds.attrs["lattice_cells"] == 16
+    assert ds.periods_used.mean() < 2.0 and ds.attrs["certification_periods"] > 0
+    small = ns.basins(p, x=(-1, 1), v=(-1, 1), grid=16, method="smooth", axes=("X", "Y"),
+                      lyapunov=False)
+    assert small.attrs["certification_periods"] == 0 and small.periods_used.mean() > 50

@@ -83,6 +83,7 @@ MODEL = model_from_equations(
                                "W", SECONDARY]},
             guards={"free": [("delta - X", "contact")], "contact": [("X - delta", "free")]},
             initial=[("X > delta", "contact")],
+            flow_is_homeomorphism=True,
             description="compliant stop (spring-damper restituting about r), RKF45"),
     },
     description="two masses in series, the primary one hitting a rigid stop",

@@ -78,6 +78,7 @@ MODEL = model_from_equations(
             guards={"free": [("delta**2 - X**2 - Y**2", "rub")],
                     "rub": [("X**2 + Y**2 - delta**2", "free")]},
             initial=[("X**2 + Y**2 > delta**2", "rub")],
+            flow_is_homeomorphism=True,
             description="rub on the stator switched at the located crossing of the circle "
                         "r = delta (a curved guard); free whirl in closed form, rub RKF45 at "
                         "rtol 1e-12"),
@@ -87,6 +88,7 @@ MODEL = model_from_equations(
             guards={"free": [("delta**2 - X**2 - Y**2", "rub")],
                     "rub": [("X**2 + Y**2 - delta**2", "free")]},
             initial=[("X**2 + Y**2 > delta**2", "rub")],
+            flow_is_homeomorphism=True,
             description="contact force regularised over the band eta (softplus), RKF45; the "
                         "modes only label the side of the circle (one field)"),
     },

@@ -123,7 +123,7 @@ from ._core import (_HOLD, _K, _N_REC, _Q, _RES, _RES_FAILED, _RES_NEW, _RUNNING
                     LABEL_UNDECIDED, N_CONFIRM, _run_round)
 from .attractors import (_CLOUD, KIND_CHAOTIC, KIND_NAMES, KIND_PERIODIC, MATCH_FACTOR,
                          _Attractors, _Clouds, _confirm_chaos, _polish)
-from .certify import _certify_all, _Lattice
+from .certify import _certify_all, _Lattice, sphere_certificates
 from .order import _coarse_to_fine_order, _Pace, _round_sizes
 
 __all__ = ["basins", "MAP_IS_HOMEOMORPHISM", "N_CONFIRM", "MATCH_FACTOR", "LABEL_UNDECIDED",
@@ -184,9 +184,13 @@ def basins(params: ParamsBase, *, x=(-3.0, 3.0), v=(-3.0, 3.0), grid=400, method
     each round is a chunk, continued from the attractors the rounds before it found, so the
     rounds run one after the other (on Dask: one worker at a time, with its threads).
 
-    A model with more than X and V: the trajectories start from every component, the
-    attractors are told apart by their section points in (X, V), and no disc or cell is
-    certified (the planar argument needs n = 2): every point runs until its section repeats.
+    A model with more than X and V (or other axes, or ``u0``): the trajectories start from
+    every component, the attractors are told apart by every component at their section
+    points, and the discs and cells are balls in the whole state space (``certify``: the
+    image of a ball is the inside of the image of its sphere), certified only with at most
+    ``certify.MAX_SPHERE_N`` components, no continuous memory and a grid of at least
+    ``certify.SPHERE_MIN_GRID`` points per axis; otherwise every point runs until its section
+    repeats.
     """
     from ...simulate import check_forced
     check_forced(params, "basins")
@@ -222,7 +226,7 @@ def basins(params: ParamsBase, *, x=(-3.0, 3.0), v=(-3.0, 3.0), grid=400, method
     scale = max(abs(x_lo), abs(x_hi), abs(v_lo), abs(v_hi), 1.0)
     tol = section_tolerance(rtol, atol, scale)
     certified = (bool(early_stop) and MAP_IS_HOMEOMORPHISM and solver.spec.flow_is_homeomorphism
-                 and base.size == 0)
+                 and (base.size == 0 or sphere_certificates(params.model, solver.spec, nx, nv)))
     order, first = _order(nx, nv)
     rounds = list(_round_sizes(n, first))
     spec = {"solver": plan_solver(solver, engine), "pk": pk, "x": (x_lo, x_hi),
@@ -322,17 +326,18 @@ def _basins_round(spec, i, carry, workers=None, progress=None):
     (x_lo, x_hi), (v_lo, v_hi), nx, nv = spec["x"], spec["v"], spec["nx"], spec["nv"]
     n = nx * nv
     order, first = _order(nx, nv)
+    axes = spec.get("axes", (0, 1))
+    base = np.asarray(spec.get("base", ()), dtype=np.float64)
     if carry is None:
         carry = {"found": _Attractors(spec["tol"]),
-                 "lat": _Lattice(x_lo, x_hi, v_lo, v_hi, nx, nv, first), "cert": {"periods": 0}}
+                 "lat": _Lattice(x_lo, x_hi, v_lo, v_hi, nx, nv, first, axes, base),
+                 "cert": {"periods": 0}}
     found, lat, cert = (carry[k] for k in ("found", "lat", "cert"))
     a, b = spec["rounds"][i]
     idx = order[a:b]
     X0 = np.linspace(x_lo, x_hi, nx)[idx // nv]
     V0 = np.linspace(v_lo, v_hi, nv)[idx % nv]
     pk, certified = spec["pk"], spec["certified"]
-    axes = spec.get("axes", (0, 1))
-    base = np.asarray(spec.get("base", ()), dtype=np.float64)
     with threads(workers), parallel_chunks(8):
         rec, cloud = _run_round_points(solver, pk, X0, V0, a, n, spec["max_periods"],
                                        spec["transient"], spec["tol"], spec["max_period"],
@@ -340,7 +345,7 @@ def _basins_round(spec, i, carry, workers=None, progress=None):
                                        None if progress is None else
                                        (lambda d, _t: progress(d - a, b - a)), axes, base)
         if certified and not all(found.certified):
-            _certify_all(found, solver, pk, cert)
+            _certify_all(found, solver, pk, cert, full=base.size > 0)
             lat.stale = True
         if certified and lat.stale and lat.active and b >= lat.start_after:
             lat.certify(found, solver, pk, cert)
@@ -378,7 +383,7 @@ def _run_round_points(solver, pk, X0, V0, done_before, n, max_periods, transient
     cxm = np.empty(m)
     ofs, oi8, ou8 = np.empty((m, 4, 1)), np.empty((m, 1), np.int8), np.empty((m, 1), np.uint8)
     while True:
-        apts, arad2, alab = found.flat()
+        apts, arad2, alab = found.flat_full() if base.size else found.flat()
         active = np.flatnonzero(recs[:, _RES] == _RUNNING)
         while active.size:
             budget = pace.share(active.size)

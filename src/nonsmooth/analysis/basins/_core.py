@@ -76,6 +76,47 @@ def _captured(x, v, apts, arad2, alab, cells, cgeo):
     return -1
 
 
+@nb.njit(cache=True, inline="always")
+def _u_at(state, i):
+    """Component i of the state vector u held in a kernel state."""
+    return state[i] if i < 2 else state[ST_EXTRA + i - 2]
+
+
+@nb.njit(cache=True, inline="always")
+def _captured_u(state, apts, arad2, alab, cells, cgeo, ia, ib, base):
+    """``_captured`` for a start with every component (``base``, the grid's axes ``ia``, ``ib``):
+    the label of the certified ball holding the kernel state's u, a lattice cell's (the ball
+    of radius sqrt(cgeo[4]) around the cell's centre, the other components those of ``base``)
+    or an attractor's (``apts`` (K, n): every component of its section points); else -1."""
+    n = base.shape[0]
+    if cells.shape[0] > 0:
+        fi = (_u_at(state, ia) - cgeo[0]) / cgeo[2]
+        fj = (_u_at(state, ib) - cgeo[1]) / cgeo[3]
+        if 0.0 <= fi < cells.shape[0] and 0.0 <= fj < cells.shape[1]:
+            lab = cells[int(fi), int(fj)]
+            if lab >= 0:
+                d2 = 0.0
+                for i in range(n):
+                    if i == ia:
+                        c = cgeo[0] + (int(fi) + 0.5) * cgeo[2]
+                    elif i == ib:
+                        c = cgeo[1] + (int(fj) + 0.5) * cgeo[3]
+                    else:
+                        c = base[i]
+                    d = _u_at(state, i) - c
+                    d2 += d * d
+                if d2 < cgeo[4]:
+                    return lab
+    for k in range(apts.shape[0]):
+        d2 = 0.0
+        for i in range(n):
+            d = _u_at(state, i) - apts[k, i]
+            d2 += d * d
+        if d2 < arad2[k]:
+            return alab[k]
+    return -1
+
+
 @nb.njit(cache=True)
 def _follow(kernel, fns, p, opts, x0, v0, max_periods, transient, tol, max_period, early, apts,
             arad2, alab, cells, cgeo, budget, state, buf, rec, cX, cV, cxm, of, oi8, ou8, ia, ib,
@@ -89,18 +130,25 @@ def _follow(kernel, fns, p, opts, x0, v0, max_periods, transient, tol, max_perio
     rec[_Q], the largest X over its last q periods in cxm[0]) or -3 failed (kernel status in
     rec[_STATUS]). ``of`` (4, 1), ``oi8``, ``ou8`` (1,) are scratch space. The grid's axes
     are state components ``ia``, ``ib`` (0, 1: X, V; the others from ``base``; an empty
-    ``base``: all others 0)."""
+    ``base``: all others 0). With ``base``, the certified balls hold every component
+    (``_captured_u``; ``apts`` (K, n)), else (X, V) only."""
     k = rec[_K]
+    full = base.shape[0] > 0
     if k == 0:
-        if early:
+        if early and not full:
             lab = _captured(x0, v0, apts, arad2, alab, cells, cgeo)
             if lab >= 0:
                 rec[_RES] = lab
                 return
-        if base.shape[0] == 0:
+        if not full:
             _init_state(state, x0, v0)
         else:
             _init_state_axes(state, x0, v0, ia, ib, base)
+            if early:
+                lab = _captured_u(state, apts, arad2, alab, cells, cgeo, ia, ib, base)
+                if lab >= 0:
+                    rec[_RES] = lab
+                    return
     L = buf.shape[1]
     bx = buf[0]
     bv = buf[1]
@@ -126,7 +174,10 @@ def _follow(kernel, fns, p, opts, x0, v0, max_periods, transient, tol, max_perio
         bv[j] = v
         bm[j] = oxa[0]
         if early:
-            lab = _captured(x, v, apts, arad2, alab, cells, cgeo)
+            if full:
+                lab = _captured_u(state, apts, arad2, alab, cells, cgeo, ia, ib, base)
+            else:
+                lab = _captured(x, v, apts, arad2, alab, cells, cgeo)
             if lab >= 0:
                 rec[_K] = k
                 rec[_RES] = lab
@@ -250,4 +301,105 @@ def _certify_cells(kernel, fns, p, opts, cx, cv, rc, todo, nsamp, m_max, apts, a
                     done = True
                     break
             if done:
+                break
+
+
+@nb.njit(cache=True, inline="always")
+def _init_state_u(state, u):
+    """``_init_state`` from every component of u (memory slots 0, mode classified)."""
+    _init_state(state, u[0], u[1])
+    for i in range(2, u.shape[0]):
+        state[ST_EXTRA + i - 2] = u[i]
+
+
+@nb.njit(cache=True, parallel=True)
+def _map_u(kernel, fns, p, opts, states, period, out, ok):
+    """Advance every state with ok[i] by ``period`` forcing periods, recording every component
+    of its u (out[i, :n], n = out.shape[1]); ok[i] = False if the kernel failed."""
+    for i in nb.prange(states.shape[0]):
+        if not ok[i]:
+            continue
+        ox, ov, orr, om, oxa, oxi = _one_interval()
+        s = kernel(fns, p, opts, states[i], 1, period - 1, 1, ox, ov, orr, om, oxa, oxi)
+        for c in range(out.shape[1]):
+            out[i, c] = _u_at(states[i], c)
+            if not math.isfinite(out[i, c]):
+                ok[i] = False
+        if s != 0:
+            ok[i] = False
+
+
+@nb.njit(cache=True, inline="always")
+def _inside_ball(U, E, apts, arad2, alab):
+    """Label of the attractor ball (``apts`` (K, n), radii squared ``arad2``) that holds the
+    image sphere U (samples (m, n), edges E between neighbouring samples) shrunk by _SHRINK,
+    with a margin of its longest edge (any image point lies within it of a sample); else -1."""
+    n = U.shape[1]
+    gap = 0.0
+    for e in range(E.shape[0]):
+        d2 = 0.0
+        for c in range(n):
+            d = U[E[e, 0], c] - U[E[e, 1], c]
+            d2 += d * d
+        if d2 > gap:
+            gap = d2
+    gap = math.sqrt(gap)
+    for a in range(apts.shape[0]):
+        r = math.sqrt(arad2[a])
+        if r <= 0.0:
+            continue
+        inside = True
+        for j in range(U.shape[0]):
+            d2 = 0.0
+            for c in range(n):
+                d = U[j, c] - apts[a, c]
+                d2 += d * d
+            if math.sqrt(d2) + gap >= _SHRINK * r:
+                inside = False
+                break
+        if inside:
+            return alab[a]
+    return -1
+
+
+@nb.njit(cache=True, parallel=True)
+def _certify_cells_u(kernel, fns, p, opts, cx, cv, rc, todo, W, E, m_max, apts, arad2, alab,
+                     out, work, ia, ib, base):
+    """``_certify_cells`` for starts with every component: the ball of radius rc around each
+    cell's centre (components ``ia``, ``ib`` = (cx[k], cv[k]), the others from ``base``) is
+    certified if, after some m <= m_max periods, the images of its sphere's samples (unit
+    directions W, neighbours E) lie inside one attractor ball (``_inside_ball``)."""
+    n = base.shape[0]
+    ns = W.shape[0]
+    for kk in nb.prange(todo.shape[0]):
+        k = todo[kk]
+        out[k] = -1
+        work[k] = 0
+        states = np.empty((ns, N_STATE))
+        u = np.empty(n)
+        for j in range(ns):
+            for c in range(n):
+                u[c] = base[c] + rc * W[j, c]
+            u[ia] = cx[k] + rc * W[j, ia]
+            u[ib] = cv[k] + rc * W[j, ib]
+            _init_state_u(states[j], u)
+        U = np.empty((ns, n))
+        ox, ov, orr, om, oxa, oxi = _one_interval()
+        for m in range(m_max):
+            bad = False
+            for j in range(ns):
+                s = kernel(fns, p, opts, states[j], 1, 0, 1, ox, ov, orr, om, oxa, oxi)
+                for c in range(n):
+                    U[j, c] = _u_at(states[j], c)
+                    if not math.isfinite(U[j, c]):
+                        bad = True
+                if s != 0 or bad:
+                    bad = True
+                    break
+            work[k] += ns
+            if bad:
+                break
+            lab = _inside_ball(U, E, apts, arad2, alab)
+            if lab >= 0:
+                out[k] = lab
                 break

@@ -63,6 +63,29 @@ class _Attractors:
         alab = np.concatenate([np.full(len(pt), k, np.int64) for k, pt in enumerate(self.points)])
         return apts, arad ** 2, alab
 
+    def centres(self, k):
+        """Every component at attractor k's section points, row i at ``points[k][i]`` (the
+        centres of its certified balls on a grid with every component); NaN rows where they
+        are not known (a chaotic attractor, a run that failed)."""
+        pts = self.points[k]
+        f = self.full[k]
+        if f is None or self.kind[k] != KIND_PERIODIC or len(f) != len(pts):
+            return np.full((len(pts), self.n_full()), np.nan)
+        f = np.roll(f, 1, axis=0)  # _full_points' last row is the first section point
+        if not (np.abs(f[:, :2] - pts) <= self.tol).all():
+            return np.full_like(f, np.nan)
+        return f
+
+    def n_full(self):
+        return next((len(f[0]) for f in self.full if f is not None), 2)
+
+    def flat_full(self):
+        """``flat`` with every component of the section points (``centres``)."""
+        if not self.points:
+            return np.zeros((0, self.n_full())), np.zeros(0), np.zeros(0, np.int64)
+        _, arad2, alab = self.flat()
+        return np.concatenate([self.centres(k) for k in range(len(self.points))]), arad2, alab
+
     def match(self, pts, u=None):
         """Label of the known periodic attractor with the same set of section points (within
         match_tol) whose period is the candidate's or divides it (a slowly converging orbit can
