@@ -188,7 +188,8 @@ def _rk_step(field, mode, tau, C, S, h, om, n, u, k0, pp, mem, rtol, atol, us, k
         e = h * (_E[0] * k0[i] + _E[2] * k2[i] + _E[3] * k3[i] + _E[4] * k4[i] + _E[5] * k5[i])
         u1[i] = x1
         sc = atol + rtol * max(abs(u[i]), abs(x1))
-        err2 += (e / sc) ** 2
+        q = e / sc
+        err2 += q * q  # (not q ** 2: see tests/test_import.py, no power operator)
         if not math.isfinite(x1):
             finite = False
     err2 = err2 / n

@@ -176,7 +176,7 @@ def _tables(w0, ws, xi, xis, F0, om, r, support):
     for m in range(2):
         propagator_table(MC, m, om, N_LEV, TB[m])
         for lev in range(N_LEV):
-            TL[m, lev] = MC[m, MC_LMAX] * 0.5 ** lev
+            TL[m, lev] = math.ldexp(MC[m, MC_LMAX], -lev)  # (exact: L / 2^lev)
     for m in range(2):
         for f in range(3):
             functional_bounds(MC[m], om, FN[f, 0], FN[f, 1], BD[m, f])

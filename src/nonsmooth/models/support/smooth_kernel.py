@@ -134,7 +134,9 @@ def _error_norm(X, V, X1, V1, eX, eV, rtol, atol):
     NaN when the step end is not finite."""
     sx = atol + rtol * max(abs(X), abs(X1))
     sv = atol + rtol * max(abs(V), abs(V1))
-    err2 = 0.5 * ((eX / sx) ** 2 + (eV / sv) ** 2)  # squared RMS error norm
+    qx = eX / sx
+    qv = eV / sv
+    err2 = 0.5 * (qx * qx + qv * qv)  # squared RMS error norm (products, not ** 2)
     if not (math.isfinite(X1) and math.isfinite(V1)):
         err2 = np.nan  # an overflow makes sx infinite and err2 zero: never accept it
     return err2
