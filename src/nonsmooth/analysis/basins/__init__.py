@@ -106,7 +106,6 @@ from __future__ import annotations
 import functools
 import warnings
 
-import numba as nb
 import numpy as np
 import xarray as xr
 
@@ -114,7 +113,7 @@ from ...errors import ParameterError
 from ...integrate.contract import N_STATE
 from ...io import (apply_state_units, check_memory, flag_attrs, provenance_attrs,
                    status_flags)
-from ...kernels import Solver, new_state, output_buffers, run
+from ...kernels import Solver, new_state, output_buffers
 from ...models.base import ParamsBase
 from ...simulate import check_float, check_int, check_params, state_u
 from ...sweep import parallel_chunks, resolve_workers, threads
