@@ -103,13 +103,14 @@ class _Lattice:
         todo = np.flatnonzero(self.cells.ravel() < 0)
         out = self.cells.ravel().copy()
         work = np.zeros(len(out), np.int64)
+        if full:
+            W, E = sphere(len(self.base), _CELL_K[len(self.base)])
         a = 0
         while a < len(todo):
             b = min(len(todo), a + self.pace.share(self.nsamp * _CELL_M_MAX))
 
             def call():
                 if full:
-                    W, E = sphere(len(self.base), _CELL_K[len(self.base)])
                     _certify_cells_u(solver.kernel, solver.fns, pk, solver.opts(), self.cx,
                                      self.cv, self.rc, todo[a:b], W, E, _CELL_M_MAX, apts,
                                      arad2, alab, out, work, *self.axes, self.base)
@@ -207,47 +208,17 @@ def _certify(solver, pk, a, r_start, period, tol, cert, contracts=_circle_contra
 
 def _certify_all(found, solver, pk, cert, full=False):
     """Capture radii for the attractors not certified yet (in discovery order: deterministic);
-    ``full``: balls around every component of the section points (``_Attractors.centres``)."""
-    if full:
-        return _certify_all_full(found, solver, pk, cert)
-    allpts = np.concatenate(found.points)
-    owner = np.concatenate([np.full(len(pt), k) for k, pt in enumerate(found.points)])
-    start = 0
-    for k, pts in enumerate(found.points):
-        q = len(pts)
-        if not found.certified[k]:
-            for i in range(q):
-                d = np.hypot(allpts[:, 0] - pts[i, 0], allpts[:, 1] - pts[i, 1])
-                d[start + i] = np.inf
-                r_start = min(_R_MAX, 0.999 * float(d.min())) if len(d) > 1 else _R_MAX
-                found.radius[k][i] = _certify(solver, pk, pts[i], r_start, q, found.tol, cert)
-            found.certified[k] = True
-        start += q
-    # balls of different attractors must not overlap (possible when an attractor found later
-    # lies near one certified earlier); a smaller ball inside a certified one stays certified
-    flat_r = np.concatenate(found.radius)
-    for i in range(len(allpts)):
-        for j in range(i + 1, len(allpts)):
-            if owner[i] != owner[j]:
-                d = float(np.hypot(*(allpts[i] - allpts[j])))
-                if flat_r[i] + flat_r[j] >= d:
-                    flat_r[i] = min(flat_r[i], 0.5 * d)
-                    flat_r[j] = min(flat_r[j], 0.5 * d)
-    start = 0
-    for k, pts in enumerate(found.points):
-        found.radius[k] = flat_r[start:start + len(pts)].copy()
-        start += len(pts)
-
-
-def _certify_all_full(found, solver, pk, cert):
-    """``_certify_all`` with balls in the whole state space (centres of unknown components:
-    no ball)."""
-    cen = [found.centres(k) for k in range(len(found.points))]
+    ``full``: balls around every component of the section points (``_Attractors.centres``;
+    where those are unknown, no ball), else discs in (X, V)."""
+    cen = [found.centres(k) for k in range(len(found.points))] if full else found.points
     allpts = np.concatenate(cen)
     owner = np.concatenate([np.full(len(c), k) for k, c in enumerate(cen)])
 
-    def dist(i_or_pt):
-        d = np.sqrt(((allpts - i_or_pt) ** 2).sum(axis=1))
+    def dist(a):
+        """Distances from ``a`` to every centre (an unknown one: infinitely far)."""
+        if not full:
+            return np.hypot(allpts[:, 0] - a[0], allpts[:, 1] - a[1])
+        d = np.sqrt(((allpts - a) ** 2).sum(axis=1))
         return np.where(np.isnan(d), np.inf, d)
 
     start = 0
@@ -257,11 +228,13 @@ def _certify_all_full(found, solver, pk, cert):
             for i in range(q):
                 d = dist(c[i])
                 d[start + i] = np.inf
-                r_start = min(_R_MAX, 0.999 * float(d.min()))
+                r_start = min(_R_MAX, 0.999 * float(d.min()))  # (alone: _R_MAX)
                 found.radius[k][i] = _certify(solver, pk, c[i], r_start, q, found.tol, cert,
-                                              _ball_contracts)
+                                              _ball_contracts if full else _circle_contracts)
             found.certified[k] = True
         start += q
+    # balls of different attractors must not overlap (possible when an attractor found later
+    # lies near one certified earlier); a smaller ball inside a certified one stays certified
     flat_r = np.concatenate(found.radius)
     for i in range(len(allpts)):
         d = dist(allpts[i])
