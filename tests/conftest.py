@@ -5,6 +5,12 @@ import os
 import subprocess
 import sys
 
+# Several test processes share the cores, each running numba's parallel loops on all of them:
+# OpenMP's idle threads then spin on cores that another process's threads need (a manifold
+# test of thousands of small parallel calls took 44 s instead of 33). Idle threads sleep here,
+# in the test processes and the commands they start; a user's own runs keep OpenMP's default.
+os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")
+
 #: Most processes the suite starts: each compiles what its tests need on an empty numba cache
 #: (the kernels take 1-2 GB while compiling), and the compiled sweeps use every core anyway.
 MAX_WORKERS = 4
