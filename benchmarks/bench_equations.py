@@ -12,8 +12,8 @@ Cases:
 * the impact oscillator, ``exact`` (closed form in free flight, derived from the equations),
   against the built-in ``impact`` model at an orbit with one impact per period.
 
-Also prints the time to build each equations model with a warm cache (SymPy derivation and
-loading the compiled functions). Usage (from the repository root)::
+Also prints the time to build each equations model again with a warm cache (its derivation read
+back from the cache, without SymPy; the compiled functions load at their first use). Usage (from the repository root)::
 
     python benchmarks/bench_equations.py [--periods 2000] [--repeat 3]
 

@@ -332,3 +332,39 @@ def test_a_resonance_over_a_period_names_its_points_by_the_period():
     assert jump_names(ns.resonance_curve(ns.preset("fig6a"), np.linspace(0.9, 1.0, 3),
                                          transient=20, record=5)) == \
         ("omega_a", "omega_b", "omega_c")
+
+
+def test_a_derivation_is_read_back_and_a_changed_model_derived_again(tmp_path, monkeypatch):
+    """A model built again (a command, a worker process) reads its derivation back instead of
+    running SymPy, and is the same model; another default, or equations that fail their
+    sample check, are derived again (a failed model is never stored)."""
+    from nonsmooth import _numba_cache
+    from nonsmooth.models import equations as eq
+    monkeypatch.setattr(_numba_cache, "cache_base", lambda: tmp_path / "numba")
+    derived = []
+    real = eq._derive
+    monkeypatch.setattr(eq, "_derive", lambda *a: derived.append(a[3]) or real(*a))
+    kw = dict(states=("X", "V"), parameters={"xi": 0.05, "F0": 3.0, "omega": 1.5, "r": 0.8},
+              modes={"free": ["V", "-X - xi*V + F0*cos(omega*t)"]},
+              guards={"free": [ns.Guard("1 - X", "free", reset={"V": "-r*V"})]},
+              admissible="X <= 1")
+    a = ns.model_from_equations("probe", **kw)
+    b = ns.model_from_equations("probe", **kw)
+    assert derived == ["exact"]
+    ma, mb = a.method("exact"), b.method("exact")
+    for field in ("closed_form", "rtol", "atol", "modes", "description", "admissible_text",
+                  "flow_is_homeomorphism"):
+        assert getattr(ma, field) == getattr(mb, field), field
+    assert ma.closed_form and (ma.curved is None) == (mb.curved is None)
+    p = b.params()
+    assert mb.admissible([0.5, 0.0], p) and not mb.admissible([1.5, 0.0], p)
+    runs = [ns.simulate(m.params(), periods=5, method="exact").X.values for m in (a, b)]
+    np.testing.assert_array_equal(runs[0], runs[1])
+    ns.model_from_equations("probe", **{**kw, "parameters": {**kw["parameters"], "r": 0.7}})
+    assert derived == ["exact", "exact"]
+    broken = {**kw, "modes": {"free": ["V", "-X + log(X - 2)"]}}  # NaN at the sample point
+    for _ in range(2):
+        with pytest.raises(ParameterError, match="model broken: "):
+            ns.model_from_equations("broken", **broken)
+    assert derived[2:] == ["exact", "exact"]
+    assert not list((tmp_path / "equations").glob("broken_*.json"))

@@ -40,6 +40,7 @@ from __future__ import annotations
 
 import hashlib
 import importlib.util
+import json
 import keyword
 import os
 import sys
@@ -125,9 +126,12 @@ def model_from_equations(name: str, *, states, parameters, modes: dict | None = 
 
     Every mistake (an expression that does not parse, an unknown name, a surface that is not
     affine or has no gradient, a mode that does not exist) is one ParameterError naming the
-    model and the place."""
-    import sympy as sp
+    model and the place.
 
+    The derivation is cached beside the generated functions, under a digest of the arguments
+    that shape it and of the package's model and integrator sources: building the same model
+    again (a command, a worker process) reads it back without SymPy and leaves the compile
+    and the sample check, done when it was first built, to the first use of a method."""
     bad = lambda msg: ParameterError(f"model {name}: {msg}")  # noqa: E731
     if methods is None:
         methods = {method: dict(modes=modes, guards=guards, initial=initial, rtol=rtol,
@@ -165,33 +169,111 @@ def model_from_equations(name: str, *, states, parameters, modes: dict | None = 
                                      for m in (spec.get("modes") or {})))
     if not mode_names:
         raise bad("at least one mode is needed")
-    sym = {nm: sp.Symbol(nm, real=True) for nm in states + pnames}
-    t = sp.Symbol("t", real=True)
-    C, S = sp.Dummy("cos_omega_t", real=True), sp.Dummy("sin_omega_t", real=True)
-    w = sym[omega] if omega is not None else 2 * sp.pi / sym[period] if period else None
-    ctx = _Context(sp, sym, t, C, S, w, set(states), name)
-    ctx.period = period
-    built = {}
     for mname, spec in methods.items():
         unknown = set(spec) - {"modes", "guards", "initial", "rtol", "atol", "description",
                                "flow_is_homeomorphism", "admissible"}
         if unknown:
             raise bad(f"method {mname}: unknown key {sorted(unknown)[0]!r}")
-        built[mname] = _method(sp, ctx, name, mname, spec, states, pnames, mode_names,
-                               closed_form, bad)
+    key = _derivation_key(name, states, params, methods, omega, period, closed_form,
+                          model_kw.get("n_memory"))
+    derived = _cached_derivation(name, key)
+    fresh = derived is None
+    if fresh:
+        import sympy as sp
+        sym = {nm: sp.Symbol(nm, real=True) for nm in states + pnames}
+        t = sp.Symbol("t", real=True)
+        C, S = sp.Dummy("cos_omega_t", real=True), sp.Dummy("sin_omega_t", real=True)
+        w = sym[omega] if omega is not None else 2 * sp.pi / sym[period] if period else None
+        ctx = _Context(sp, sym, t, C, S, w, set(states), name)
+        ctx.period = period
+        derived = {mname: _derive(sp, ctx, name, mname, spec, states, pnames, mode_names,
+                                  closed_form, bad) for mname, spec in methods.items()}
+    built = {mname: _method(name, mname, entry, pnames) for mname, entry in derived.items()}
     if isinstance(contact_modes, (tuple, list)):
         contact_modes = sum(1 << _mode_index(m, mode_names, bad) for m in contact_modes)
     model = Model(name=name, description=description or "a model written as equations",
                   parameters=params, state_names=states, mode_names=mode_names,
                   methods=built, omega=omega, period=period, forcing_amplitude=forcing_amplitude,
                   contact_modes=contact_modes, **model_kw)
-    for mname in built:
-        model.fns(mname)  # compile and sample-check now: a malformed model fails here
+    if fresh:
+        for mname in built:
+            model.fns(mname)  # compile and sample-check now: a malformed model fails here
+        _store_derivation(name, key, derived)
     return model
 
 
-def _method(sp, ctx, name, mname, spec, states, pnames, mode_names, closed_form, bad) -> Method:
-    """One method's :class:`Method`: parse, derive, generate and load its functions."""
+def _derivation_key(name, states, params, methods, omega, period, closed_form,
+                    n_memory) -> str | None:
+    """Digest of what a model's derivation and its sample check (at the parameters' defaults)
+    depend on (None where an argument has no stable text, e.g. an object shown by its
+    address)."""
+    from .._numba_cache import USER_LAYER, source_digest
+    text = repr((__version__, source_digest(USER_LAYER), name, states, params,
+                 sorted((m, sorted(spec.items())) for m, spec in methods.items()), omega,
+                 period, closed_form, n_memory))
+    if " at 0x" in text:
+        return None
+    return hashlib.sha256(text.encode()).hexdigest()[:16]
+
+
+def _derivation_path(name: str, key: str) -> Path | None:
+    from .._numba_cache import cache_base
+    base = cache_base()
+    if base is None:
+        return None
+    folder = base.parent / "equations" if base.name == "numba" else base / "equations"
+    safe = "".join(ch if ch.isalnum() else "_" for ch in name)
+    return folder / f"{safe}_{key}.json"
+
+
+def _cached_derivation(name: str, key: str | None) -> dict | None:
+    """The derivation stored under ``key`` (see :func:`_store_derivation`), or None."""
+    path = _derivation_path(name, key) if key else None
+    try:
+        got = json.loads(path.read_text()) if path is not None and path.is_file() else None
+    except (OSError, ValueError):
+        return None
+    return got["methods"] if isinstance(got, dict) and got.get("key") == key else None
+
+
+def _store_derivation(name: str, key: str | None, derived: dict) -> None:
+    """Keep a derivation whose methods compiled and passed their sample check (an unwritable
+    cache only means deriving again next time)."""
+    path = _derivation_path(name, key) if key else None
+    if path is None:
+        return
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        fd, tmp = tempfile.mkstemp(dir=path.parent, suffix=".tmp")  # unique per process
+        with os.fdopen(fd, "w") as fh:
+            json.dump({"key": key, "methods": derived}, fh)
+        os.replace(tmp, path)
+    except OSError:
+        pass
+
+
+def _method(name, mname, entry, pnames) -> Method:
+    """One method's :class:`Method` from its derivation (:func:`_derive`): the generated
+    functions loaded, the rest as derived."""
+    module = _load(f"{name}_{mname}", entry["source"])
+    extra = {}
+    if entry["admissible"] is not None:
+        def admissible(u, params):
+            return bool(module.admissible([float(x) for x in u],
+                                          [float(getattr(params, k)) for k in pnames]))
+        extra = {"admissible": admissible, "admissible_text": entry["admissible"]}
+    return Method(module.field, module.jacobian, module.guards, module.transition,
+                  module.initial, module.linear if entry["closed_form"] else None,
+                  curved=module.curved if entry["curved"] else None,
+                  closed_form=entry["closed_form"],
+                  flow_is_homeomorphism=entry["flow_is_homeomorphism"],
+                  modes=tuple(entry["modes"]), rtol=entry["rtol"], atol=entry["atol"],
+                  description=entry["description"], **extra)
+
+
+def _derive(sp, ctx, name, mname, spec, states, pnames, mode_names, closed_form, bad) -> dict:
+    """One method's derivation: parse, derive and generate its functions' source; returns
+    plain data (:func:`_method` builds the Method)."""
     n = len(states)
     own = tuple(spec.get("modes") or {})
     if not own:
@@ -221,45 +303,36 @@ def _method(sp, ctx, name, mname, spec, states, pnames, mode_names, closed_form,
     linear = {m: (ctx.linear(fields[m]) if n == 2 else None, ctx.linear_general(fields[m]))
               for m in own} if closed_form else {}
     linear = {m: v for m, v in linear.items() if v[1] is not None}
+    text = spec.get("admissible")
+    cond = _admissible(ctx, text, bad) if text is not None else None
     try:
         source = _source(sp, ctx, states, pnames, mode_names, own, fields, rows, branches,
-                         init, linear)
+                         init, linear, cond)
     except Exception as exc:  # noqa: BLE001 - an expression SymPy cannot print as Python
         raise bad(f"method {mname}: cannot generate its functions "
                   f"({type(exc).__name__}: {str(exc).splitlines()[0] if str(exc) else ''})"
                   ) from None
-    module = _load(f"{name}_{mname}", source)
-    has_linear = bool(linear)
     rtol, atol = spec.get("rtol"), spec.get("atol")
     if mname == "exact" and rtol is None and atol is None \
             and not all(m in linear for m in own):
         rtol, atol = EXACT_RTOL, EXACT_ATOL  # nonlinear modes of an exact method: RKF45, tight
-    curved = any(not isinstance(r, list) for rs in rows.values() for r in rs)
-    return Method(module.field, module.jacobian, module.guards, module.transition,
-                  module.initial, module.linear if has_linear else None,
-                  curved=module.curved if curved else None,
-                  closed_form=has_linear,
-                  flow_is_homeomorphism=bool(spec.get("flow_is_homeomorphism", False)),
-                  modes=tuple(mode_names.index(m) for m in own), rtol=rtol, atol=atol,
-                  description=spec.get("description")
-                  or f"written as equations ({len(own)} modes)",
-                  **_admissible(sp, ctx, spec.get("admissible"), states, pnames, bad))
+    return {"source": source, "closed_form": bool(linear),
+            "curved": any(not isinstance(r, list) for rs in rows.values() for r in rs),
+            "flow_is_homeomorphism": bool(spec.get("flow_is_homeomorphism", False)),
+            "modes": [mode_names.index(m) for m in own],
+            "rtol": None if rtol is None else float(rtol),
+            "atol": None if atol is None else float(atol),
+            "description": spec.get("description") or f"written as equations ({len(own)} modes)",
+            "admissible": None if text is None else str(text)}
 
 
-def _admissible(sp, ctx, text, states, pnames, bad) -> dict:
+def _admissible(ctx, text, bad):
     """``admissible=`` of a method: a condition on the state and the parameters (no t) that
-    every start must meet, as Method(admissible=, admissible_text=)."""
-    if text is None:
-        return {}
+    every start must meet (the generated ``admissible(u, p)`` evaluates it)."""
     cond = ctx.condition(text, "admissible")
     if ctx.t in cond.free_symbols or ctx.C in cond.free_symbols or ctx.S in cond.free_symbols:
         raise bad("admissible: a condition on the state and the parameters, without t")
-    args = [ctx.sym[k] for k in states] + [ctx.sym[k] for k in pnames]
-    test = sp.lambdify(args, cond, modules="math")
-
-    def admissible(u, params):
-        return bool(test(*(float(x) for x in u), *(float(getattr(params, k)) for k in pnames)))
-    return {"admissible": admissible, "admissible_text": str(text)}
+    return cond
 
 
 _STEPS: dict = {}
@@ -504,8 +577,9 @@ class _Context:
 
 
 def _source(sp, ctx, states, pnames, mode_names, own, fields, rows, branches, init,
-            linear) -> str:
-    """The Python source of the seven model functions."""
+            linear, admissible=None) -> str:
+    """The Python source of the seven model functions, and of ``admissible(u, p)`` (plain
+    Python) where the method has that condition."""
     from sympy.printing.pycode import PythonCodePrinter
 
     n = len(states)
@@ -664,6 +738,9 @@ def _source(sp, ctx, states, pnames, mode_names, own, fields, rows, branches, in
 
     src += ["", "", "def linear(mode, p, out):", *unpack_p]
     src += by_mode(linear_body)
+    if admissible is not None:
+        src += ["", "", "def admissible(u, p):", *unpack_u, *unpack_p,
+                f"    return {code(admissible)}"]
     return "\n".join(src) + "\n"
 
 
