@@ -162,10 +162,9 @@ def bifurcation_cmd(
     plot: PlotOpt = None,
 ):
     """Bifurcation diagram of the section X(kT) over a parameter (Figs. 9 and 11)."""
+    params = load_params(preset, set_, model, "table3", method=method)
     from ..analysis.bifurcation import SWEEPS, bifurcation_diagram
     from ..simulate import check_int
-
-    params = load_params(preset, set_, model, "table3", method=method)
     method = resolve_method(params, method)
     preset = preset_label(params, preset, "table3")
     from ..simulate import check_forced
@@ -224,10 +223,9 @@ def resonance_cmd(
 ):
     """Resonance curve (max X, min X versus omega, swept up and down with continuation) and
     the frequencies omega_a (contact starts), omega_b, omega_c (jumps), like Fig. 6."""
+    params = load_params(preset, set_, model, "fig6a", method=method)
     from ..analysis.resonance import resonance_curve
     from ..simulate import check_int
-
-    params = load_params(preset, set_, model, "fig6a", method=method)
     method = resolve_method(params, method)
     preset = preset_label(params, preset, "fig6a")
     from ..simulate import check_forced

@@ -54,10 +54,9 @@ def limit_cycle_cmd(
     """A limit cycle of a self-excited system (its forcing amplitude 0), stable or unstable, by
     Newton shooting on a section surface: its period, section point and nontrivial Floquet
     multipliers. Exit status 1 when no cycle was found."""
+    params = load_params(preset, set_, model, method=method)
     from ..analysis.autonomous import limit_cycle
     from ..io import components
-
-    params = load_params(preset, set_, model, method=method)
     method = _method(params, method)
     preset = preset_label(params, preset, None)
     check_outputs(out, None)
@@ -102,12 +101,11 @@ def equilibria_cmd(
     """Equilibria of a self-excited system (its forcing amplitude 0) in every mode, with their
     eigenvalues; with --param, the first one followed along a parameter with its Hopf
     points."""
+    params = load_params(preset, set_, model, method=method)
     from ..analysis.autonomous import equilibria, equilibrium_branch
     from ..errors import ParameterError
     from ..io import components
     from .analyses import value_range
-
-    params = load_params(preset, set_, model, method=method)
     method = _method(params, method)
     preset = preset_label(params, preset, None)
     check_outputs(out, None)
@@ -170,12 +168,11 @@ def surface_bifurcation_cmd(
     """Bifurcation diagram of a self-excited system on a section surface: at each value of
     --param (each run continuing from the previous one), the crossings of the section after a
     transient; cycles, their crossings per turn, and values that come to rest."""
+    params = load_params(preset, set_, model, method=method)
     from ..analysis.autonomous import surface_bifurcation_diagram
     from ..plot.autonomous import plot_surface_bifurcation
     from ..plot.common import check_show
     from .analyses import value_range
-
-    params = load_params(preset, set_, model, method=method)
     method = _method(params, method)
     preset = preset_label(params, preset, None)
     check_outputs(out, plot)

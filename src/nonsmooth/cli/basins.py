@@ -127,11 +127,10 @@ def attractors_cmd(
     conditions (as basins), matched value to value, with their basin shares, births and
     deaths. With -o, finished values are kept in <out>.chunks until the result is written:
     the same command resumes an interrupted run."""
+    params = load_params(preset, set_, model, "fig7", method=method)
     from ..analysis.attractor_continuation import attractor_continuation
     from ..sweep import Progress
     from .analyses import default_range, value_range
-
-    params = load_params(preset, set_, model, "fig7", method=method)
     method = resolve_method(params, method)
     preset = preset_label(params, preset, "fig7")
     from ..simulate import check_forced

@@ -110,10 +110,9 @@ def continue_cmd(
     (fold, period doubling, Neimark-Sacker, grazing); the branch figure, stable solid,
     unstable dashed. With --section (or a model without forcing): the limit cycles of a
     self-excited system on that section surface, their periods unknowns."""
+    params = load_params(preset, set_, model, "fig6a", method=method or "exact")
     from ..analysis.continuation import continuation
     from ..simulate import check_float, check_int
-
-    params = load_params(preset, set_, model, "fig6a", method=method or "exact")
     if method is None and "exact" in params.model.methods:
         method = "exact"
     method = resolve_method(params, method)

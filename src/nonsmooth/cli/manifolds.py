@@ -57,11 +57,10 @@ def manifolds_cmd(
     (default: Fig. 7's saddle): both branches of each, grown in the window (--x, --v), their
     homoclinic points, and a figure over the basins (--basins-grid). Exit status 1 when no
     orbit was found from the start, 2 when the orbit found is not a saddle."""
+    params = load_params(preset, set_, model, "fig7", method=method or "exact")
     from ..analysis.manifolds import BRANCH_NAMES, manifolds
     from ..analysis.stability import periodic_orbit
     from ..simulate import check_int
-
-    params = load_params(preset, set_, model, "fig7", method=method or "exact")
     if method is None and "exact" in params.model.methods:
         method = "exact"
     method = resolve_method(params, method)

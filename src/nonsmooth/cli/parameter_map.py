@@ -57,9 +57,8 @@ def map_cmd(
 ):
     """Two-parameter map of the settled motion: period, chaos (lambda1), amplitude, contact.
     With -o the finished chunks are kept in FILE.chunks and the same command resumes there."""
-    from ..analysis.parameter_map import parameter_map, regimes
-
     params = load_params(preset, set_, model, "table3", method=method)
+    from ..analysis.parameter_map import parameter_map, regimes
     method = resolve_method(params, method)
     preset = preset_label(params, preset, "table3")
     from ..simulate import check_forced

@@ -35,9 +35,8 @@ def simulate_cmd(
 ):
     """Integrate one trajectory; save every state component and the region over time (netCDF)
     and a Fig. 3-style plot."""
-    from ..simulate import simulate
-
     params = load_params(preset, set_, model, "table1", method=method)
+    from ..simulate import simulate
     method = resolve_method(params, method)
     preset = preset_label(params, preset, "table1")
     from ..plot.common import check_show

@@ -75,10 +75,9 @@ def lyapunov_cmd(
     """Lyapunov spectrum of the trajectory from (x0, v0) (Benettin's method on the variational
     equations with saltation matrices): exponents per unit time and per forcing period with
     standard errors, their sum and a verdict (chaotic, quasi-periodic, not settled)."""
+    params = load_params(preset, set_, model, "table3", method=method)
     from ..analysis.stability import lyapunov
     from ..simulate import check_int
-
-    params = load_params(preset, set_, model, "table3", method=method)
     method = resolve_method(params, method)
     preset = preset_label(params, preset, "table3")
     check_int("periods", periods, 1)
@@ -128,10 +127,9 @@ def orbit_cmd(
     """A k-periodic orbit, stable or unstable, by Newton shooting from (x0, v0): section
     points, Floquet multipliers, stability, max/min X and contact fraction; a phase portrait
     with the multipliers (in the plane --show names). Exit status 1 when no orbit was found."""
+    params = load_params(preset, set_, model, "fig7", method=method or "exact")
     from ..analysis.stability import periodic_orbit
     from ..simulate import check_int
-
-    params = load_params(preset, set_, model, "fig7", method=method or "exact")
     if method is None and "exact" in params.model.methods:
         method = "exact"
     method = resolve_method(params, method)
