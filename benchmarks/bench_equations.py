@@ -13,7 +13,8 @@ Cases:
   against the built-in ``impact`` model at an orbit with one impact per period.
 
 Also prints the time to build each equations model again with a warm cache (its derivation read
-back from the cache, without SymPy; the compiled functions load at their first use). Usage (from the repository root)::
+back from the cache, without SymPy; the compiled functions load at their first use). Usage
+(from the repository root)::
 
     python benchmarks/bench_equations.py [--periods 2000] [--repeat 3]
 
