@@ -109,12 +109,11 @@ def poincare_cmd(
 ):
     """Stroboscopic Poincaré map (t = kT) with period and contact classification; plot like
     Figs. 10 and 12 (phase portrait with its section points, and the map)."""
+    params = load_params(preset, set_, model, "table3", method=method)
     from ..analysis.poincare import poincare
     from ..simulate import check_int
-
     if points is not None:  # deprecated name
         record = check_int("points", points, 1)
-    params = load_params(preset, set_, model, "table3", method=method)
     method = resolve_method(params, method)
     preset = preset_label(params, preset, "table3")
     check_int("record", record, 1)
