@@ -216,14 +216,29 @@ def _derivation_key(name, states, params, methods, omega, period, closed_form,
     return hashlib.sha256(text.encode()).hexdigest()[:16]
 
 
+def _folder(base: Path) -> Path:
+    """Where generated functions and derivations live, beside numba's cache ``base``."""
+    return base.parent / "equations" if base.name == "numba" else base / "equations"
+
+
+def _safe(name: str) -> str:
+    return "".join(ch if ch.isalnum() else "_" for ch in name)
+
+
+def _write_atomic(path: Path, text: str) -> None:
+    """Write ``text`` to ``path`` through a file unique to this process, then rename it (an
+    identical file written by another process at the same time is as good); OSError as is."""
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(dir=path.parent, suffix=".tmp")
+    with os.fdopen(fd, "w") as fh:
+        fh.write(text)
+    os.replace(tmp, path)
+
+
 def _derivation_path(name: str, key: str) -> Path | None:
     from .._numba_cache import cache_base
     base = cache_base()
-    if base is None:
-        return None
-    folder = base.parent / "equations" if base.name == "numba" else base / "equations"
-    safe = "".join(ch if ch.isalnum() else "_" for ch in name)
-    return folder / f"{safe}_{key}.json"
+    return None if base is None else _folder(base) / f"{_safe(name)}_{key}.json"
 
 
 def _cached_derivation(name: str, key: str | None) -> dict | None:
@@ -243,11 +258,7 @@ def _store_derivation(name: str, key: str | None, derived: dict) -> None:
     if path is None:
         return
     try:
-        path.parent.mkdir(parents=True, exist_ok=True)
-        fd, tmp = tempfile.mkstemp(dir=path.parent, suffix=".tmp")  # unique per process
-        with os.fdopen(fd, "w") as fh:
-            json.dump({"key": key, "methods": derived}, fh)
-        os.replace(tmp, path)
+        _write_atomic(path, json.dumps({"key": key, "methods": derived}))
     except OSError:
         pass
 
@@ -749,21 +760,17 @@ def _load(name: str, source: str):
     caches the compiled functions of a module with a file."""
     from .._numba_cache import cache_base
     digest = hashlib.sha256((__version__ + source).encode()).hexdigest()[:16]
-    safe = "".join(ch if ch.isalnum() else "_" for ch in name)
+    safe = _safe(name)
     base = cache_base()
     if base is None:
         warnings.warn(f"model {name}: no writable cache directory; its functions compile on "
                       f"every run", stacklevel=3)
         base = Path(tempfile.mkdtemp(prefix="nonsmooth-eq-"))
-    folder = base.parent / "equations" if base.name == "numba" else base / "equations"
+    folder = _folder(base)
     path = folder / f"{safe}_{digest}.py"
     try:
-        folder.mkdir(parents=True, exist_ok=True)
         if not path.exists() or path.read_text() != source:
-            fd, tmp = tempfile.mkstemp(dir=folder, suffix=".tmp")  # unique per process
-            with os.fdopen(fd, "w") as f:
-                f.write(source)
-            os.replace(tmp, path)  # atomic: another process's identical file is as good
+            _write_atomic(path, source)
     except OSError as exc:
         raise ParameterError(f"model {name}: cannot write its generated functions to "
                              f"{folder} ({exc.strerror or exc})") from None
