@@ -28,7 +28,7 @@ import argparse
 import time
 
 import nonsmooth as ns
-from bench_user_model import rate  # the same timing loop (this folder is on sys.path)
+from bench_user_model import EXAMPLE, rate  # the same timing loop (this folder is on sys.path)
 
 FREE = "-xi*V - X - beta*X**3 + F0*cos(omega*t)"
 FORCE = "k_s*(X - gap) + c_s*V"
@@ -76,7 +76,7 @@ def main():
     ap.add_argument("--periods", type=int, default=2000)
     ap.add_argument("--repeat", type=int, default=3)
     args = ap.parse_args()
-    hand_duffing = ns.model("examples/one_sided_duffing.py:MODEL")
+    hand_duffing = ns.model(EXAMPLE)
     impact = ns.model("impact")
     cases = []
     for label, build, method, hand in (

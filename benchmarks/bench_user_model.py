@@ -14,12 +14,15 @@ from __future__ import annotations
 
 import argparse
 import time
+from pathlib import Path
 
 import nonsmooth as ns
 from nonsmooth import kernels
 from nonsmooth.models.base import KERNEL_GENERIC
 
-CASES = (("stick_slip", "stribeck"), ("examples/one_sided_duffing.py:MODEL", None))
+#: the README's example, found from this file (the benchmark runs from any folder)
+EXAMPLE = f"{Path(__file__).resolve().parents[1] / 'examples' / 'one_sided_duffing.py'}:MODEL"
+CASES = (("stick_slip", "stribeck"), (EXAMPLE, None))
 
 
 def rate(params, method, periods, repeat):
@@ -53,7 +56,7 @@ def main():
             params = m.preset(preset) if preset else m.params()
             t, code = rate(params, method, args.periods, args.repeat)
             total += t
-            print(f"{spec:40s} {method:7s} {args.periods / t:10.4g}  {code}")
+            print(f"{m.name:40s} {method:7s} {args.periods / t:10.4g}  {code}")
     print(f"{total:.4f}")
 
 
