@@ -21,15 +21,33 @@ def pytest_xdist_auto_num_workers(config):
 
 
 def pytest_configure(config):
-    """On an empty numba cache, compile the slow kernels side by side in subprocesses before
-    the workers start: otherwise every worker compiles the same kernels at once, one after the
-    other within each worker."""
+    """On an empty numba cache, compile the slow kernels in subprocesses before the workers
+    start (otherwise every worker compiles the same kernels at once, one after the other within
+    each worker): the generic kernel, by far the longest (about two minutes), alone on one
+    core; on another, one after the other, the other kernels and then every built-in model's
+    compiled functions (and the derivations of the models written as equations), which every
+    worker would otherwise build for itself."""
     if hasattr(config, "workerinput") or not getattr(config.option, "numprocesses", None):
         return
     from nonsmooth import _numba_cache
     # the modules whose first compile takes minutes, less ``kernels``, which imports them
     todo = [m for m in _numba_cache.SLOW_MODULES
             if m != "kernels" and not _numba_cache.is_compiled(m)]
-    procs = [subprocess.Popen([sys.executable, "-c", f"import nonsmooth.{m}"]) for m in todo]
+    if not todo:
+        return
+    longest = "integrate.hybrid"
+    codes = [f"import nonsmooth.{longest}"] if longest in todo else []
+    codes.append("".join(f"import nonsmooth.{m}\n" for m in todo if m != longest)
+                 + _BUILTIN_MODELS)
+    procs = [subprocess.Popen([sys.executable, "-c", code]) for code in codes]
     for p in procs:
         p.wait()
+
+
+_BUILTIN_MODELS = """
+from nonsmooth.models import BUILTIN, model
+for name in BUILTIN:
+    m = model(name)
+    for method in m.methods:
+        m.fns(method)
+"""
