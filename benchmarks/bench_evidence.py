@@ -8,10 +8,11 @@ defaults (lambda1 on) against the same analysis with ``lyapunov=False``, in the 
 
 Usage::
 
-    python benchmarks/bench_evidence.py [--repeat 2]
+    python benchmarks/bench_evidence.py [--repeat 2] [--cases poincare]
 
 Prints a table (seconds with and without lambda1, their ratio) and, last, the total seconds
-with lambda1 (for ``../shared/tools/side-by-side``).
+with lambda1 (for ``../shared/tools/side-by-side``). ``--cases`` keeps the cases whose name
+contains one of the given words (comma-separated).
 """
 
 from __future__ import annotations
@@ -44,10 +45,14 @@ def best(f, repeat):
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--repeat", type=int, default=2)
+    ap.add_argument("--cases", default="", help="comma-separated words: only the cases named so")
     args = ap.parse_args()
+    words = [w for w in args.cases.split(",") if w]
     total = 0.0
     print(f"{'analysis':28s} {'method':7s} {'lambda1 on':>11s} {'off':>8s} {'ratio':>6s}")
     for name, f in CASES.items():
+        if words and not any(w in name for w in words):
+            continue
         for method in ("smooth", "exact"):
             f(method, True)  # warm-up: compile / load
             on = best(lambda: f(method, True), args.repeat)
