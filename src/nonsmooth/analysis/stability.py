@@ -456,8 +456,8 @@ def _lambda1_many(tangent, fns, P, opts, states, align, periods, N, cmi, logs, s
 #: Benettin's lambda1 of a non-periodic point runs in stages: FIRST_STAGE periods, then stages
 #: of a quarter of the periods done (at least FIRST_STAGE / 2), and stops once its standard
 #: error is at most REL_STDERR |lambda1| (or the record is used up): a record of at most
-#: FIRST_STAGE periods runs whole, in one stage. Stages growing by a quarter overshoot the
-#: periods the target needs by at most a quarter (doubling stages: by up to 100 %).
+#: FIRST_STAGE periods runs whole, in one stage. A point runs at most half as many periods
+#: again as the target needs, a quarter past 2 FIRST_STAGE (doubling stages: up to twice).
 FIRST_STAGE = 1000
 STAGE_GROWTH = 4
 REL_STDERR = 0.05
@@ -469,7 +469,8 @@ def lambda1_points(P, solver, states, periods: int, *, blocks: int = 10, workers
     re-classified for the generic kernel, mode -1), at most ``periods`` periods each after
     max(20, min(periods, FIRST_STAGE) // 4) periods of alignment, one tangent vector (all
     local cores). A point stops after the first stage (FIRST_STAGE periods, then a quarter
-    of the periods done, at least FIRST_STAGE / 2) at which the standard error from ``blocks`` block means is <= REL_STDERR |lambda1|.
+    of the periods done, at least FIRST_STAGE / 2) at which the standard error from
+    ``blocks`` block means is <= REL_STDERR |lambda1|.
     Returns (lambda1, stderr, status) arrays."""
     from ..sweep import deferred_interrupts, threads
     setup = TangentSetup(solver)
