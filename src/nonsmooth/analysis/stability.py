@@ -459,7 +459,6 @@ def _lambda1_many(tangent, fns, P, opts, states, align, periods, N, cmi, logs, s
 #: FIRST_STAGE periods runs whole, in one stage. A point runs at most half as many periods
 #: again as the target needs, a quarter past 2 FIRST_STAGE (doubling stages: up to twice).
 FIRST_STAGE = 1000
-STAGE_GROWTH = 4
 REL_STDERR = 0.05
 
 
@@ -494,7 +493,7 @@ def lambda1_points(P, solver, states, periods: int, *, blocks: int = 10, workers
     while active.size:
         done = int(used[active[0]])  # the active points have all run the same stages
         m = min(periods - done, FIRST_STAGE if done == 0
-                else max(FIRST_STAGE // 2, done // STAGE_GROWTH))
+                else max(FIRST_STAGE // 2, done // 4))
         Pa, Sa, Ya = P[active], S[active], Ys[active]
         la = np.zeros((active.size, m))
         sa = np.zeros(active.size, np.int64)

@@ -63,6 +63,12 @@ def _split_source(name: str) -> tuple[str, str]:
     return path, attr
 
 
+def safe_name(text: str) -> str:
+    """``text`` with every character but letters and digits replaced by ``_``: a name for the
+    modules and cache files of users' models."""
+    return "".join(ch if ch.isalnum() else "_" for ch in text)
+
+
 def file_digest(source: str) -> str | None:
     """sha1 (16 hex digits) of the contents of a model's file (``path.py[:NAME]``, e.g. a
     ``Model.source``), or None where it cannot be read."""
@@ -82,8 +88,7 @@ def _load_user(path: str, attr: str) -> Model:
         raise ParameterError(f"model: no such file {path!r}")
     # the module's name comes from the file's name and contents; its numba functions are
     # cached under that name (``_numba_cache.register_user_file``), whatever folder it is in
-    stem = "".join(ch if ch.isalnum() else "_" for ch in os.path.basename(full))
-    modname = f"nonsmooth_user_model_{stem}_{file_digest(full)}"
+    modname = f"nonsmooth_user_model_{safe_name(os.path.basename(full))}_{file_digest(full)}"
     from .._numba_cache import register_user_file
     register_user_file(full, modname)
     spec = importlib.util.spec_from_file_location(modname, full)

@@ -51,6 +51,7 @@ from pathlib import Path
 
 from .._version import __version__
 from ..errors import ParameterError
+from . import safe_name
 from .base import Method, Model, Param
 
 #: Functions allowed in expressions (SymPy names), and the two of regularised contact and
@@ -221,10 +222,6 @@ def _folder(base: Path) -> Path:
     return base.parent / "equations" if base.name == "numba" else base / "equations"
 
 
-def _safe(name: str) -> str:
-    return "".join(ch if ch.isalnum() else "_" for ch in name)
-
-
 def _write_atomic(path: Path, text: str) -> None:
     """Write ``text`` to ``path`` through a file unique to this process, then rename it (an
     identical file written by another process at the same time is as good); OSError as is."""
@@ -235,15 +232,16 @@ def _write_atomic(path: Path, text: str) -> None:
     os.replace(tmp, path)
 
 
-def _derivation_path(name: str, key: str) -> Path | None:
+def _derivation_path(name: str, key: str | None) -> Path | None:
+    """The file of the derivation stored under ``key``; None without a key or a cache."""
     from .._numba_cache import cache_base
-    base = cache_base()
-    return None if base is None else _folder(base) / f"{_safe(name)}_{key}.json"
+    base = cache_base() if key else None
+    return None if base is None else _folder(base) / f"{safe_name(name)}_{key}.json"
 
 
 def _cached_derivation(name: str, key: str | None) -> dict | None:
     """The derivation stored under ``key`` (see :func:`_store_derivation`), or None."""
-    path = _derivation_path(name, key) if key else None
+    path = _derivation_path(name, key)
     try:
         got = json.loads(path.read_text()) if path is not None and path.is_file() else None
     except (OSError, ValueError):
@@ -254,7 +252,7 @@ def _cached_derivation(name: str, key: str | None) -> dict | None:
 def _store_derivation(name: str, key: str | None, derived: dict) -> None:
     """Keep a derivation whose methods compiled and passed their sample check (an unwritable
     cache only means deriving again next time)."""
-    path = _derivation_path(name, key) if key else None
+    path = _derivation_path(name, key)
     if path is None:
         return
     try:
@@ -760,7 +758,7 @@ def _load(name: str, source: str):
     caches the compiled functions of a module with a file."""
     from .._numba_cache import cache_base
     digest = hashlib.sha256((__version__ + source).encode()).hexdigest()[:16]
-    safe = _safe(name)
+    safe = safe_name(name)
     base = cache_base()
     if base is None:
         warnings.warn(f"model {name}: no writable cache directory; its functions compile on "
