@@ -549,8 +549,9 @@ def test_series_primitives_against_exact_arithmetic():
 
     import scipy.linalg
 
-    from nonsmooth.integrate.linmodes import (N_TAYLOR, lin_matrix, poly_m4, poly_tangent, pval,
-                                              pvalue, series_powers, taylor_terms)
+    from nonsmooth.integrate.linmodes import (N_TAYLOR, THETA_POLY, lin_matrix, poly_m4,
+                                              poly_tangent, pval, pvalue, series_powers,
+                                              taylor_terms)
     rng = np.random.default_rng(7)
     fact = np.array([float(math.factorial(j)) for j in range(N_TAYLOR + 1)])
     for _ in range(20):
@@ -580,18 +581,18 @@ def test_series_primitives_against_exact_arithmetic():
     A = rng.normal(size=(n, n))
     lin = np.concatenate([A.ravel(), rng.normal(size=3 * n)])
     m = n + 3
-    PW = np.zeros((N_TAYLOR + 1, m * m))
-    rho = lin_matrix(lin, n, om, PW[1])
-    Mx = PW[1].copy()
+    PW = np.zeros((m * m, N_TAYLOR + 1))
+    rho = lin_matrix(lin, n, om, PW[:, 1])
+    Mx = PW[:, 1].copy()
     series_powers(m, PW)
     u = rng.normal(size=n)
     C, S = math.cos(0.4), math.sin(0.4)
-    TW = np.zeros((N_TAYLOR + 1, m))
+    TW = np.zeros((m, N_TAYLOR + 1))
     taylor_terms(PW, n, u, C, S, TW)
     z0 = np.concatenate([u, [1.0, C, S]])
-    for s in (0.3 / rho, 2.0 / rho):  # up to a full piece, THETA_POLY / rho
+    for s in (0.3 / rho, THETA_POLY / rho):  # up to a full piece
         want = scipy.linalg.expm(Mx.reshape(m, m) * s) @ z0
-        got = np.array([pvalue(TW[:, i], s) for i in range(m)])
+        got = np.array([pvalue(TW[i], s) for i in range(m)])
         assert np.max(np.abs(got - want)) < 1e-13 * np.abs(want).max()
         assert abs(got[n + 1] - math.cos(0.4 + om * s)) < 1e-14  # the forcing rows rotate
         # the tangent: exp(A s) on the state rows, memory rows left alone

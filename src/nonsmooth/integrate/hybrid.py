@@ -470,7 +470,7 @@ def _mode_class(linear, closed, mode, pp, lin, MC, mcs, om, MF, n, MXR, PW):
             else:
                 mcs[mode] = _MC_RESONANT
         elif r == 2:
-            MXR[mode] = lin_matrix(lin, n, om, PW[mode, 1])
+            MXR[mode] = lin_matrix(lin, n, om, PW[mode, :, 1])
             series_powers(n + 3, PW[mode])
             mcs[mode] = _MC_POLY
     return int(mcs[mode])
@@ -1150,13 +1150,13 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
     o += n + 1
     MXR = view(ws, o, (MAX_MODES,))  # rate rho of each _MC_POLY mode (piece: THETA_POLY / rho)
     o += MAX_MODES
-    TW = view(ws, o, (N_TAYLOR + 1, m3))  # the Taylor terms of the current piece
+    TW = view(ws, o, (m3, N_TAYLOR + 1))  # the Taylor terms of the current piece (a row each)
     o += (N_TAYLOR + 1) * m3
     cp = view(ws, o, (N_TAYLOR + 1,))  # a guard as a polynomial on the piece
     o += N_TAYLOR + 1
     PE = view(ws, o, (n, n))  # exp(A h) of a series piece, for the tangent
     pt = view(ws, o + n * n, (n,))
-    PW = view(ws, total, (MAX_MODES, N_TAYLOR + 1, m3 * m3))  # M^j / j! of each _MC_POLY mode
+    PW = view(ws, total, (MAX_MODES, m3 * m3, N_TAYLOR + 1))  # M^j / j! of each _MC_POLY mode
     if o + n * n + n != total:  # the views above and ``sizes`` must agree (views are not bounds-
         return st.NON_FINITE  # checked); a mismatch is a bug of this function, caught by tests
     pp[:] = p

@@ -9,9 +9,10 @@ With the augmented state z = (u, 1, cos omega t, sin omega t) the mode is z' = M
 
 so z(s) = exp(M s) z(0): the matrix exponential with its integral for the forcing, whatever
 A (singular or not, resonant or not). On a piece of length L with rho L <= THETA_POLY
-(rho: the balanced norm of M, ``lin_matrix``) the exponential series converges fast: z(s) = sum_j w_j s^j with
-w_j = M^j z0 / j!, and N_TAYLOR = 28 terms leave a remainder below 2^29 / 29! ~ 6e-23 of
-the scale of the state. The state is then a polynomial in s known to round-off, and so is
+(rho: the balanced norm of M, ``lin_matrix``) the exponential series converges fast:
+z(s) = sum_j w_j s^j with w_j = M^j z0 / j!, and N_TAYLOR = 28 terms leave a remainder below
+1.1 * 3^29 / 29! ~ 9e-18 of the scale of the state (a twentieth of its last bit; the largest
+term, 3^3 / 3! = 4.5, sets the round-off of the sum). The state is then a polynomial in s known to round-off, and so is
 every affine guard: g(s) = sum_j (G_k . w_j) s^j (a guard row is a row over z). Its derivative
 bounds follow from the coefficients (``poly_m4``), so the exit test is certified
 (``hybrid._guard_exit``).
@@ -28,7 +29,7 @@ import numba as nb
 import numpy as np
 
 
-THETA_POLY = 2.0  # rho L on a full piece
+THETA_POLY = 3.0  # rho L on a full piece
 N_TAYLOR = 28  # terms beyond the constant one (a multiple of 4: ``pval``)
 POLY_DEPTH = 30  # halvings of a piece in its exit test (<= hybrid.SCAN_DEPTH: its stack)
 X_SAMPLES = 4  # samples of V per piece for the extrema of X
@@ -82,51 +83,69 @@ def lin_matrix(lin, n, om, Mx):
 
 @nb.njit(cache=True, fastmath={"contract", "reassoc"})
 def series_powers(m, PW):
-    """PW[j] = M^j / j! (j = 0..N_TAYLOR; each m x m, row-major in the flat PW[j]) from
-    PW[1] = M (``lin_matrix`` writes it there): the series' matrices of a mode, computed once
+    """PW[:, j] = M^j / j! (j = 0..N_TAYLOR; entry (i, q) of each m x m matrix in row
+    PW[i m + q], so that a row holds one entry's N_TAYLOR + 1 terms, contiguous) from
+    PW[:, 1] = M (``lin_matrix`` writes it there): the series' matrices of a mode, computed once
     per mode and call (``taylor_terms`` then costs one product with z0 per term, independent
     of each other, instead of a chain of N_TAYLOR products each waiting for the last)."""
     mm = m * m
     for i in range(mm):
-        PW[0, i] = 0.0
+        PW[i, 0] = 0.0
     for i in range(m):
-        PW[0, i * m + i] = 1.0
+        PW[i * m + i, 0] = 1.0
     for j in range(2, N_TAYLOR + 1):
         inv = 1.0 / j
         for i in range(m):
             for q in range(m):
                 acc = 0.0
                 for r in range(m):
-                    acc += PW[1, i * m + r] * PW[j - 1, r * m + q]
-                PW[j, i * m + q] = acc * inv
+                    acc += PW[i * m + r, 1] * PW[r * m + q, j - 1]
+                PW[i * m + q, j] = acc * inv
 
 
-@nb.njit(cache=True, fastmath={"contract", "reassoc"})
+@nb.njit(cache=True, fastmath={"contract"})
 def taylor_terms(PW, n, u, C, S, TW):
-    """TW[j] = M^j z0 / j! (j = 0..N_TAYLOR) for z0 = (u, 1, C, S), from the matrices PW[j]
-    = M^j / j! (``series_powers``). The sums read u, C and S, not TW[0]: a store into TW
-    would otherwise order every later load of z0 behind it (the arrays may alias), about
-    twice the time. The augmented rows are known in form: the constant's is 0 beyond j = 0
-    (M's row n is zero) and the forcing pair rotates, (C, S) -> (-om S, om C) / j, two terms of
-    PW each."""
+    """TW[:, j] = M^j z0 / j! (j = 0..N_TAYLOR) for z0 = (u, 1, C, S), from the matrices
+    PW[:, j] = M^j / j! (``series_powers``): TW[i] holds component i's N_TAYLOR + 1 terms.
+    Four terms at a time, each summed in registers over the row (forcing columns first, then
+    the state's), on contiguous rows of PW; the sums read u, C and S, not TW[:, 0], which may
+    alias them. The augmented rows are known in form: the constant's is 0 beyond j = 0 (M's
+    row n is zero) and the forcing pair rotates, (C, S) -> (-om S, om C) / j, two terms of PW
+    each."""
     m = n + 3
     for i in range(n):
-        TW[0, i] = u[i]
-    TW[0, n] = 1.0
-    TW[0, n + 1] = C
-    TW[0, n + 2] = S
+        TW[i, 0] = u[i]
+    TW[n, 0] = 1.0
+    TW[n + 1, 0] = C
+    TW[n + 2, 0] = S
+    for i in range(n):
+        r = i * m
+        t = TW[i]
+        a = PW[r + n]
+        b = PW[r + n + 1]
+        c = PW[r + n + 2]
+        for j in range(1, N_TAYLOR + 1, 4):  # (N_TAYLOR: a multiple of 4)
+            s0 = a[j] + b[j] * C + c[j] * S
+            s1 = a[j + 1] + b[j + 1] * C + c[j + 1] * S
+            s2 = a[j + 2] + b[j + 2] * C + c[j + 2] * S
+            s3 = a[j + 3] + b[j + 3] * C + c[j + 3] * S
+            for q in range(n):
+                w = PW[r + q]
+                uq = u[q]
+                s0 += w[j] * uq
+                s1 += w[j + 1] * uq
+                s2 += w[j + 2] * uq
+                s3 += w[j + 3] * uq
+            t[j] = s0
+            t[j + 1] = s1
+            t[j + 2] = s2
+            t[j + 3] = s3
     rc = (n + 1) * m
     rs = (n + 2) * m
     for j in range(1, N_TAYLOR + 1):
-        for i in range(n):
-            r = i * m
-            acc = PW[j, r + n] + PW[j, r + n + 1] * C + PW[j, r + n + 2] * S
-            for q in range(n):
-                acc += PW[j, r + q] * u[q]
-            TW[j, i] = acc
-        TW[j, n] = 0.0
-        TW[j, n + 1] = PW[j, rc + n + 1] * C + PW[j, rc + n + 2] * S
-        TW[j, n + 2] = PW[j, rs + n + 1] * C + PW[j, rs + n + 2] * S
+        TW[n, j] = 0.0
+        TW[n + 1, j] = PW[rc + n + 1, j] * C + PW[rc + n + 2, j] * S
+        TW[n + 2, j] = PW[rs + n + 1, j] * C + PW[rs + n + 2, j] * S
 
 
 @nb.njit(cache=True, inline="always", fastmath={"contract"})
@@ -168,24 +187,27 @@ def pvalue(c, s):
 def poly_state(TW, n, s, out):
     """out[0:n] = u(s) (``pvalue`` of each component's Taylor terms)."""
     for i in range(n):
-        out[i] = pvalue(TW[:, i], s)
+        out[i] = pvalue(TW[i], s)
 
 
 @nb.njit(cache=True, inline="always")
 def poly_component(TW, i, s):
     """(value, derivative) at s of component i of z."""
-    return pval(TW[:, i], s)
+    return pval(TW[i], s)
 
 
 @nb.njit(cache=True)
 def guard_poly(G, k, n, TW, c):
-    """c[j] = G[k] . TW[j]: the guard as a polynomial in s on the piece."""
-    m = n + 3
+    """c[j] = G[k] . TW[:, j]: the guard as a polynomial in s on the piece (each term summed
+    over the components in order; a zero coefficient of the row adds nothing)."""
     for j in range(N_TAYLOR + 1):
-        acc = 0.0
-        for i in range(m):
-            acc += G[k, i] * TW[j, i]
-        c[j] = acc
+        c[j] = 0.0
+    for i in range(n + 3):
+        g = G[k, i]
+        if g != 0.0:
+            t = TW[i]
+            for j in range(N_TAYLOR + 1):
+                c[j] += g * t[j]
 
 
 @nb.njit(cache=True, inline="always")
@@ -213,8 +235,9 @@ def poly_m4(c, b):
 @nb.njit(cache=True)
 def poly_x_extrema(TW, hs, xmax, xmin, cv):
     """(xmax, xmin) with the interior extrema of X = z[0] on the piece [0, hs]: where
-    V = z[0]' changes sign between X_SAMPLES + 1 points (a piece spans THETA_POLY = 2 of the
-    fastest rate: at most one sign change is expected between two of them), located by
+    V = z[0]' changes sign between X_SAMPLES + 1 points (a piece spans THETA_POLY = 3 of the
+    fastest rate, so the samples are 3/4 of it apart and V's sign changes about pi: at most
+    one is expected between two of them), located by
     ``poly_root`` on V (``cv``: work, N_TAYLOR + 1; the kernel lends it the guard's
     polynomial ``cp``, rebuilt before every use)."""
     va = poly_component(TW, 0, 0.0)[1]
@@ -225,7 +248,7 @@ def poly_x_extrema(TW, hs, xmax, xmin, cv):
         if va * vb < 0.0:
             sg = 1.0 if va >= 0.0 else -1.0  # g = sg V >= 0 at the lower end
             for j in range(N_TAYLOR):
-                cv[j] = sg * (j + 1) * TW[j + 1, 0]
+                cv[j] = sg * (j + 1) * TW[0, j + 1]
             cv[N_TAYLOR] = 0.0
             lo, hi = poly_root(cv, hs, (q - 1) / X_SAMPLES, q / X_SAMPLES, sg * va, sg * vb,
                                1e-15)
@@ -239,12 +262,13 @@ def poly_x_extrema(TW, hs, xmax, xmin, cv):
 @nb.njit(cache=True, fastmath={"contract", "reassoc"})
 def poly_tangent(PW, n, h, Y, E, t):
     """Y[0:n] <- exp(A h) Y[0:n] (the homogeneous part; memory rows unchanged): E = exp(A h) =
-    sum_j h^j PW[j][:n, :n] (the top-left block of M^j / j! is A^j / j!; ``pvalue`` per
-    entry), then each column multiplied by it; E (n x n) and t (n): work arrays."""
+    sum_j h^j PW[:, j][:n, :n] (the top-left block of M^j / j! is A^j / j!; ``pvalue`` per
+    entry, on its row of PW), then each column multiplied by it; E (n x n) and t (n): work
+    arrays."""
     m = n + 3
     for a in range(n):
         for b in range(n):
-            E[a, b] = pvalue(PW[:, a * m + b], h)
+            E[a, b] = pvalue(PW[a * m + b], h)
     for col in range(Y.shape[1]):
         for a in range(n):
             acc = 0.0
