@@ -12,10 +12,10 @@ A (singular or not, resonant or not). On a piece of length L with rho L <= THETA
 (rho: the balanced norm of M, ``lin_matrix``) the exponential series converges fast:
 z(s) = sum_j w_j s^j with w_j = M^j z0 / j!, and N_TAYLOR = 28 terms leave a remainder below
 1.1 * 3^29 / 29! ~ 9e-18 of the scale of the state (a twentieth of its last bit; the largest
-term, 3^3 / 3! = 4.5, sets the round-off of the sum). The state is then a polynomial in s known to round-off, and so is
-every affine guard: g(s) = sum_j (G_k . w_j) s^j (a guard row is a row over z). Its derivative
-bounds follow from the coefficients (``poly_m4``), so the exit test is certified
-(``hybrid._guard_exit``).
+term, 3^3 / 3! = 4.5, sets the round-off of the sum). The state is then a polynomial in s
+known to round-off, and so is every affine guard: g(s) = sum_j (G_k . w_j) s^j (a guard row
+is a row over z). Its derivative bounds follow from the coefficients (``poly_m4``), so the
+exit test is certified (``hybrid._guard_exit``).
 
 A model declares such a mode through ``linear(mode, p, out) -> 2`` with ``out[0:n*n]`` = A
 (row-major), then b, f_c, f_s (n each); see ``models.base``.
@@ -237,14 +237,12 @@ def poly_x_extrema(TW, hs, xmax, xmin, cv):
     """(xmax, xmin) with the interior extrema of X = z[0] on the piece [0, hs]: where
     V = z[0]' changes sign between X_SAMPLES + 1 points (a piece spans THETA_POLY = 3 of the
     fastest rate, so the samples are 3/4 of it apart and V's sign changes about pi: at most
-    one is expected between two of them), located by
-    ``poly_root`` on V (``cv``: work, N_TAYLOR + 1; the kernel lends it the guard's
-    polynomial ``cp``, rebuilt before every use)."""
+    one is expected between two of them), located by ``poly_root`` on V (``cv``: work,
+    N_TAYLOR + 1; the kernel lends it the guard's polynomial ``cp``, rebuilt before every
+    use)."""
     va = poly_component(TW, 0, 0.0)[1]
     for q in range(1, X_SAMPLES + 1):  # V at X_SAMPLES points: each sign change an extremum
-        a = (q - 1) * hs / X_SAMPLES
-        b = q * hs / X_SAMPLES
-        vb = poly_component(TW, 0, b)[1]
+        vb = poly_component(TW, 0, q * hs / X_SAMPLES)[1]
         if va * vb < 0.0:
             sg = 1.0 if va >= 0.0 else -1.0  # g = sg V >= 0 at the lower end
             for j in range(N_TAYLOR):
