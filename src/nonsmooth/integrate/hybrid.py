@@ -155,6 +155,51 @@ def _stage_rotations(om, h):
 
 
 @nb.njit(cache=True, inline="always", fastmath=_FM)
+def _rk_step2(field, mode, tau, C, S, h, u, k0, pp, mem, rtol, atol, us, k1, k2, k3, k4, k5, u1,
+              c2, s2, c3, s3, c4, s4, C1, S1, c12, s12):
+    """``_rk_step`` for two states, operation for operation, with the stages in scalars."""
+    x, v = u[0], u[1]
+    x0, v0 = k0[0], k0[1]
+    us[0] = x + h * (_A[1, 0] * x0)
+    us[1] = v + h * (_A[1, 0] * v0)
+    field(mode, tau + _C[1] * h, C * c2 - S * s2, S * c2 + C * s2, us, pp, mem, k1)
+    x1, v1 = k1[0], k1[1]
+    us[0] = x + h * (_A[2, 0] * x0 + _A[2, 1] * x1)
+    us[1] = v + h * (_A[2, 0] * v0 + _A[2, 1] * v1)
+    field(mode, tau + _C[2] * h, C * c3 - S * s3, S * c3 + C * s3, us, pp, mem, k2)
+    x2, v2 = k2[0], k2[1]
+    us[0] = x + h * (_A[3, 0] * x0 + _A[3, 1] * x1 + _A[3, 2] * x2)
+    us[1] = v + h * (_A[3, 0] * v0 + _A[3, 1] * v1 + _A[3, 2] * v2)
+    field(mode, tau + _C[3] * h, C * c12 - S * s12, S * c12 + C * s12, us, pp, mem, k3)
+    x3, v3 = k3[0], k3[1]
+    us[0] = x + h * (_A[4, 0] * x0 + _A[4, 1] * x1 + _A[4, 2] * x2 + _A[4, 3] * x3)
+    us[1] = v + h * (_A[4, 0] * v0 + _A[4, 1] * v1 + _A[4, 2] * v2 + _A[4, 3] * v3)
+    field(mode, tau + h, C1, S1, us, pp, mem, k4)
+    x4, v4 = k4[0], k4[1]
+    us[0] = x + h * (_A[5, 0] * x0 + _A[5, 1] * x1 + _A[5, 2] * x2 + _A[5, 3] * x3
+                     + _A[5, 4] * x4)
+    us[1] = v + h * (_A[5, 0] * v0 + _A[5, 1] * v1 + _A[5, 2] * v2 + _A[5, 3] * v3
+                     + _A[5, 4] * v4)
+    field(mode, tau + _C[5] * h, C * c4 - S * s4, S * c4 + C * s4, us, pp, mem, k5)
+    x5, v5 = k5[0], k5[1]
+    X1 = x + h * (_B[0] * x0 + _B[2] * x2 + _B[3] * x3 + _B[4] * x4 + _B[5] * x5)
+    eX = h * (_E[0] * x0 + _E[2] * x2 + _E[3] * x3 + _E[4] * x4 + _E[5] * x5)
+    V1 = v + h * (_B[0] * v0 + _B[2] * v2 + _B[3] * v3 + _B[4] * v4 + _B[5] * v5)
+    eV = h * (_E[0] * v0 + _E[2] * v2 + _E[3] * v3 + _E[4] * v4 + _E[5] * v5)
+    u1[0] = X1
+    u1[1] = V1
+    qx = eX / (atol + rtol * max(abs(x), abs(X1)))
+    qv = eV / (atol + rtol * max(abs(v), abs(V1)))
+    err2 = 0.0
+    err2 += qx * qx
+    err2 += qv * qv
+    err2 = err2 / 2
+    if not (math.isfinite(X1) and math.isfinite(V1)):
+        err2 = np.nan  # an overflow makes sc infinite and err2 zero: never accept it
+    return err2, C1, S1
+
+
+@nb.njit(cache=True, inline="always", fastmath=_FM)
 def _rk_step(field, mode, tau, C, S, h, om, n, u, k0, pp, mem, rtol, atol, us, k1, k2, k3, k4,
              k5, u1):
     """One RKF45 step of length h from (tau, u) with field(mode) fixed; k0 = field at the start.
@@ -163,6 +208,9 @@ def _rk_step(field, mode, tau, C, S, h, om, n, u, k0, pp, mem, rtol, atol, us, k
     c2, s2, c3, s3, c4, s4, c8, s8, c12, s12 = _stage_rotations(om, h)
     C1 = C * c8 - S * s8
     S1 = S * c8 + C * s8
+    if n == 2:  # the same arithmetic in scalars (most models): loops of two cost more
+        return _rk_step2(field, mode, tau, C, S, h, u, k0, pp, mem, rtol, atol, us, k1, k2, k3,
+                         k4, k5, u1, c2, s2, c3, s3, c4, s4, C1, S1, c12, s12)
     for i in range(n):
         us[i] = u[i] + h * (_A[1, 0] * k0[i])
     field(mode, tau + _C[1] * h, C * c2 - S * s2, S * c2 + C * s2, us, pp, mem, k1)
@@ -1098,7 +1146,7 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
     sizes = (len(p), 10 * n, nme, MAX_GUARDS * (n + 3), MAX_MODES * (N_MC + 7), nlin,
              N_BD * (1 + MAX_GUARDS), (SCAN_DEPTH + 1) * 5, _NS * nt * mt, 6 * nt + nt * nj,
              2 * nme if tan else 0, len(cmi), mt, n + 1,
-             MAX_MODES + (N_TAYLOR + 1) * (m3 + 1) + n * n + n)
+             MAX_MODES + (N_TAYLOR + 1) * (m3 + 1) + n * n + n + 2 * MAX_GUARDS)
     total = 0
     for z in sizes:
         total += z
@@ -1156,9 +1204,15 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
     o += N_TAYLOR + 1
     PE = view(ws, o, (n, n))  # exp(A h) of a series piece, for the tangent
     pt = view(ws, o + n * n, (n,))
+    o += n * n + n
+    # each affine guard's g and g' at the step's end, which are those at the next step's start
+    # while ``gv`` (an accepted step without a switch in a mode whose guards are all affine and
+    # not a series piece's: the state, its derivative and the phase are copied from the end)
+    gc = view(ws, o, (MAX_GUARDS,))
+    dc = view(ws, o + MAX_GUARDS, (MAX_GUARDS,))
     PW = view(ws, total, (MAX_MODES, m3 * m3, N_TAYLOR + 1))  # M^j / j! of each _MC_POLY mode
-    if o + n * n + n != total:  # the views above and ``sizes`` must agree (views are not bounds-
-        return st.NON_FINITE  # checked); a mismatch is a bug of this function, caught by tests
+    if o + 2 * MAX_GUARDS != total:  # the views above and ``sizes`` must agree (views are not
+        return st.NON_FINITE  # bounds-checked); a mismatch is a bug of this function (tests)
     pp[:] = p
     Y = unowned(Y)  # owned by the caller for the whole call
     L_out = unowned(L_out)
@@ -1240,6 +1294,7 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
     rejected = False
     n_tiny = 0
     t_switch = -1e300
+    gv = False
     j = 0
     for it in range(n_total):
         j += 1
@@ -1249,7 +1304,13 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
         mask = 1 << mode
         while tau < t_end:
             # ---- immediate exit at the step start: g <= 0 and moving out ----
-            if ncv == 0:
+            if gv:
+                k_tr = -1
+                for k in range(ng):
+                    if gc[k] <= 0.0 and dc[k] < 0.0:
+                        k_tr = k
+                        break
+            elif ncv == 0:
                 k_tr = _immediate_exit(G, ng, n, u, f0, C, S, om)
             else:
                 k_tr = _immediate_exit_curved(curved, mode, tau, G, ng, n, u, f0, C, S, om, pp,
@@ -1330,23 +1391,18 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
                             s_lo = lo
                             k_tr = k
                         continue
-                    g0 = _gval(G, k, n, u, C, S)
-                    d0 = _dgval(G, k, n, f0, C, S, om)
+                    if gv:
+                        g0 = gc[k]
+                        d0 = dc[k]
+                    else:
+                        g0 = _gval(G, k, n, u, C, S)
+                        d0 = _dgval(G, k, n, f0, C, S, om)
                     if g0 < 0.0:
                         g0 = 0.0  # round-off after the switch into this mode (d0 >= 0 here)
                     g1 = _gval(G, k, n, u1, C1, S1)
                     d1 = _dgval(G, k, n, f1, C1, S1, om)
-                    q0 = 0.0
-                    q1 = 0.0
-                    q2 = 0.0
-                    q3 = 0.0
-                    if not cf:  # projection of the state's cubic Hermite on the guard
-                        for i in range(n):
-                            du = u1[i] - u[i]
-                            q0 += G[k, i] * u[i]
-                            q1 += G[k, i] * (hs * f0[i])
-                            q2 += G[k, i] * (3.0 * du - 2.0 * hs * f0[i] - hs * f1[i])
-                            q3 += G[k, i] * (-2.0 * du + hs * f0[i] + hs * f1[i])
+                    gc[k] = g1
+                    dc[k] = d1
                     hi = 2.0
                     ghi = 0.0
                     if g1 < 0.0:
@@ -1370,6 +1426,17 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
                         if min(g0, g1) - _HERM_SLOPE * sl - err > 1e-9 * (abs(g0) + abs(g1)
                                                                           + sl):
                             continue
+                    q0 = 0.0
+                    q1 = 0.0
+                    q2 = 0.0
+                    q3 = 0.0
+                    if not cf:  # projection of the state's cubic Hermite on the guard (after
+                        for i in range(n):  # the test above, which most steps pass)
+                            du = u1[i] - u[i]
+                            q0 += G[k, i] * u[i]
+                            q1 += G[k, i] * (hs * f0[i])
+                            q2 += G[k, i] * (3.0 * du - 2.0 * hs * f0[i] - hs * f1[i])
+                            q3 += G[k, i] * (-2.0 * du + hs * f0[i] + hs * f1[i])
                     b1, b2, b3 = herm_coeffs(g0, d0, g1, d1, hs)
                     r1, r2 = quad_roots01(b1, 2.0 * b2, 3.0 * b3)
                     for q in (r1, r2):
@@ -1491,9 +1558,12 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
                     f0[i] = f1[i]
                 C = C1
                 S = S1
+                gv = k_tr < 0 and not pm and ncv == 0
                 tau = t_end if last else tau + hs
                 xmax = max(xmax, u[0])
                 xmin = min(xmin, u[0])
+            if k_tr >= 0:
+                gv = False  # a reset, or the section row flips
             if k_tr >= 0 and k_tr == ksec:
                 # ---- a crossing of the section surface: record it, flip the row ----
                 if SEC[0] == 0.0 or SEC[0] == -sgn:
@@ -1578,6 +1648,7 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
             break  # stopped on the section (the outputs of this interval are not written)
         if j == per_period:
             j = 0
+            gv = False  # the phase restarts at (C0, S0), f0 is computed again
             t_done += T
             tau = t0
             t_switch -= T
