@@ -29,7 +29,7 @@ form). The last stdout line is one number: the total nonsmooth seconds of the ti
 Usage::
 
     python benchmarks/bench_models.py [--periods 4000] [--scipy-periods 30] [--repeat 3]
-                                      [--models support,stick_slip]
+                                      [--models support,stick_slip] [--methods smooth]
 """
 
 from __future__ import annotations
@@ -290,6 +290,7 @@ def main(argv=None):
     ap.add_argument("--repeat", type=int, default=3, help="nonsmooth runs (best is kept)")
     ap.add_argument("--scipy-repeat", type=int, default=1, help="scipy runs (best is kept)")
     ap.add_argument("--models", default=",".join(BUILTIN), help="comma-separated model names")
+    ap.add_argument("--methods", default="smooth,exact", help="comma-separated methods")
     args = ap.parse_args(argv)
     wanted = [m.strip() for m in args.models.split(",") if m.strip()]
 
@@ -303,7 +304,7 @@ def main(argv=None):
         model = ns.model(name)
         params = make(model)
         for method in ("smooth", "exact"):
-            if method not in model.methods:
+            if method not in model.methods or method not in args.methods.split(","):
                 continue
             ours, secs, status = rate_nonsmooth(model, params, method, args.periods, args.repeat)
             total += secs
