@@ -157,7 +157,8 @@ def _stage_rotations(om, h):
 @nb.njit(cache=True, inline="always", fastmath=_FM)
 def _rk_step2(field, mode, tau, C, S, h, u, k0, pp, mem, rtol, atol, us, k1, k2, k3, k4, k5, u1,
               c2, s2, c3, s3, c4, s4, C1, S1, c12, s12):
-    """``_rk_step`` for two states, operation for operation, with the stages in scalars."""
+    """``_rk_step`` for two states, its formulas written out with the stages in scalars (the
+    fastmath contraction and reassociation may round them differently in the last bit)."""
     x, v = u[0], u[1]
     x0, v0 = k0[0], k0[1]
     us[0] = x + h * (_A[1, 0] * x0)
