@@ -209,7 +209,7 @@ def _rk_step(field, mode, tau, C, S, h, om, n, u, k0, pp, mem, rtol, atol, us, k
     c2, s2, c3, s3, c4, s4, c8, s8, c12, s12 = _stage_rotations(om, h)
     C1 = C * c8 - S * s8
     S1 = S * c8 + C * s8
-    if n == 2:  # the same arithmetic in scalars (most models): loops of two cost more
+    if n == 2:  # the same formulas in scalars (most models): loops of two cost more
         return _rk_step2(field, mode, tau, C, S, h, u, k0, pp, mem, rtol, atol, us, k1, k2, k3,
                          k4, k5, u1, c2, s2, c3, s3, c4, s4, C1, S1, c12, s12)
     for i in range(n):
