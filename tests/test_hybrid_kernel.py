@@ -601,3 +601,69 @@ def test_series_primitives_against_exact_arithmetic():
         want_Y[:n] = scipy.linalg.expm(A * s) @ Y[:n]
         poly_tangent(PW, n, s, Y, np.zeros((n, n)), np.zeros(n))
         assert np.max(np.abs(Y - want_Y)) < 1e-13 * np.abs(want_Y).max()
+
+
+def test_series_root_and_extrema_against_closed_forms():
+    """``poly_root`` brackets the first root of a series polynomial to its tolerance whichever
+    first guess it takes (the Taylor cubic's for a root near the piece's start: a short bounce
+    after an impact, from the surface or from above it; the Hermite's farther in), against the
+    closed form of a ball's flight on a vibrating table (a parabola less a sinusoid, evaluated
+    in 40-digit arithmetic: in doubles its cancellation alone would move a small bounce's root
+    by 1e-12); ``poly_x_extrema`` finds the apex of the flight, also on a piece cut short (one
+    sample interval), against its closed form."""
+    import mpmath
+
+    from nonsmooth.integrate.linmodes import (N_TAYLOR, THETA_POLY, guard_poly, lin_matrix,
+                                              poly_root, poly_x_extrema, pval, series_powers,
+                                              taylor_terms)
+    g, A, om = 1.0, 0.033, 2.0 * math.pi
+    n, m = 2, 5
+    lin = np.zeros(n * n + 3 * n)
+    lin[1] = 1.0  # Z' = V, V' = -g + A om^2 sin(om t)
+    lin[n * n + 1] = -g
+    lin[n * n + 2 * n + 1] = A * om * om
+    PW = np.zeros((m * m, N_TAYLOR + 1))
+    rho = lin_matrix(lin, n, om, PW[:, 1])
+    series_powers(m, PW)
+    hs = THETA_POLY / rho
+    G = np.zeros((1, m))
+    G[0, 0] = 1.0
+    TW = np.zeros((m, N_TAYLOR + 1))
+    cp = np.zeros(N_TAYLOR + 1)
+    cv = np.zeros(N_TAYLOR + 1)
+    taken = set()
+    for z0, v0, ph in ((0.0, 1e-6, 0.3), (0.0, 1e-3, 2.5), (0.0, 0.02, 0.3), (1e-6, -1e-3, 2.5),
+                       (0.0, 0.1, 2.5), (0.02, 0.3, 4.0)):
+        C, S = math.cos(ph), math.sin(ph)
+
+        mp = mpmath.mp.clone()
+        mp.dps = 40
+        mC, mS, mph = mp.cos(ph), mp.sin(ph), mp.mpf(ph)
+
+        def z(t):  # the closed form of Z from (z0, v0) at phase ph
+            t = mp.mpf(t)
+            return (z0 + (v0 + A * om * mC) * t - g * t * t / 2
+                    - A * (mp.sin(mph + om * t) - mS))
+
+        def v(t):
+            t = mp.mpf(t)
+            return v0 + A * om * mC - g * t - A * om * mp.cos(mph + om * t)
+
+        taylor_terms(PW, n, np.array([z0, v0]), C, S, TW)
+        guard_poly(G, 0, n, TW, cp)
+        # the first sign change of Z on a geometric grid, then the closed form's root
+        ts = np.geomspace(1e-9, hs, 2001)
+        neg = np.flatnonzero([z(t) < 0 for t in ts])
+        assert neg.size and neg[0] > 0
+        t_root = float(mp.findroot(z, (ts[neg[0] - 1], ts[neg[0]]), solver="anderson"))
+        hi = min(1.0, ts[neg[0]] / hs)
+        lo, hi = poly_root(cp, hs, 0.0, hi, max(z0, 0.0), pval(cp, hi * hs)[0], 1e-13)
+        assert hi - lo <= 1e-13
+        assert lo * hs - 1e-15 <= t_root <= hi * hs + 1e-15
+        taken.add(t_root / hs < 0.25)
+        # the apex of the flight up to the root (a piece cut short at the impact)
+        if v0 > 0.0:
+            t_apex = mp.findroot(v, (1e-12, t_root), solver="anderson")
+            xmax, _ = poly_x_extrema(TW, t_root, -np.inf, np.inf, cv, rho)
+            assert abs(xmax - float(z(t_apex))) <= 1e-17 + 1e-13 * abs(float(z(t_apex)))
+    assert taken == {True, False}  # both first guesses were exercised

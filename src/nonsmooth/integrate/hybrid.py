@@ -654,19 +654,16 @@ def _g_eval(kind, s, cp, curved, mode, k, tau, C, S, hs, om, n, u, f0, u1, f1, p
 
 @nb.njit(cache=True)
 def _guard_scan(kind, cp, curved, mode, k, tau, C, S, hs, om, n, u, f0, u1, f1, pp, mem, gr,
-                us, stack, end, s_best, pm, TW):
+                us, stack, ga, da, gb, db, end, s_best, pm, TW):
     """The first piece of [0, end] (fractions of the step, left to right) that holds a
-    negative value of guard k (``_g_eval``): (a, b, g(b)) with g(a) >= 0 > g(b), or
+    negative value of guard k (``_g_eval``; (ga, da) and (gb, db): its value and rate at 0
+    and at ``end``, which the caller has): (a, b, g(b)) with g(a) >= 0 > g(b), or
     (-1, -1, 0). A piece passes when the cubic Hermite of (g, g') at its ends, less its error
     bound, stays >= 0 (``herm_clear``): the bound of g'''' is the polynomial's own (kind 0,
     rigorous) or four times the one the true g at the piece's midpoint implies (kind 1).
     Else the piece is halved (at most POLY_DEPTH / CURVED_DEPTH times); on a piece whose end
     is negative the Hermite's interior minima are tried first."""
-    ga, da = _g_eval(kind, 0.0, cp, curved, mode, k, tau, C, S, hs, om, n, u, f0, u1, f1, pp,
-                     mem, gr, us, pm, TW)
     ga = max(ga, 0.0)  # round-off after the switch into this mode
-    gb, db = _g_eval(kind, end, cp, curved, mode, k, tau, C, S, hs, om, n, u, f0, u1, f1, pp,
-                     mem, gr, us, pm, TW)
     max_depth = POLY_DEPTH if kind == 0 else CURVED_DEPTH
     a = 0.0
     b = end
@@ -749,7 +746,7 @@ def _guard_exit(kind, cp, curved, mode, k, tau, C, S, hs, om, n, u, f0, u1, f1, 
         if g1 >= 0.0 and min(g0, g1) - 2.0 * _HERM_SLOPE * sl > 1e-9 * (abs(g0) + abs(g1) + sl):
             return 2.0, 2.0
     lo, hi, ghi = _guard_scan(kind, cp, curved, mode, k, tau, C, S, hs, om, n, u, f0, u1, f1,
-                              pp, mem, gr, us, stack, 1.0, s_best, pm, TW)
+                              pp, mem, gr, us, stack, g0, d0, g1, d1, 1.0, s_best, pm, TW)
     if hi < 0.0:
         return 2.0, 2.0
     for _ in range(8):
@@ -771,8 +768,10 @@ def _guard_exit(kind, cp, curved, mode, k, tau, C, S, hs, om, n, u, f0, u1, f1, 
             return -1.0, -1.0
         if not lo > 0.0:
             break
+        gl, dl = _g_eval(kind, lo, cp, curved, mode, k, tau, C, S, hs, om, n, u, f0, u1, f1,
+                         pp, mem, gr, us, pm, TW)
         a2, b2, g2 = _guard_scan(kind, cp, curved, mode, k, tau, C, S, hs, om, n, u, f0, u1, f1,
-                                 pp, mem, gr, us, stack, lo, lo, pm, TW)
+                                 pp, mem, gr, us, stack, g0, d0, gl, dl, lo, lo, pm, TW)
         if b2 < 0.0:
             break
         lo, hi, ghi = a2, b2, g2
@@ -1551,7 +1550,7 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
                     xmax, xmin = _x_extrema_exact(MC, mode, om, MF[mode], y0, z0, C, S, u[0],
                                                   u[1], u1[0], u1[1], hs, xmax, xmin)
                 elif pm:
-                    xmax, xmin = poly_x_extrema(TW, hs, xmax, xmin, cp)
+                    xmax, xmin = poly_x_extrema(TW, hs, xmax, xmin, cp, MXR[mode])
                 else:
                     xmax, xmin = _x_extrema(u[0], f0[0], u1[0], f1[0], hs, xmax, xmin)
                 for i in range(n):

@@ -34,6 +34,9 @@ N_TAYLOR = 28  # terms beyond the constant one (a multiple of 4: ``pval``)
 POLY_DEPTH = 30  # halvings of a piece in its exit test (<= hybrid.SCAN_DEPTH: its stack)
 X_SAMPLES = 4  # samples of V per piece for the extrema of X
 _HERMITE_TOL = 1e-9  # the first guess of ``poly_root``: fraction of its bracket
+#: ``poly_root`` starts from the Taylor cubic's root when that lies in this first fraction of
+#: the piece (rho s <= 0.75 on a full piece: the cubic then guesses the root to about 1 %)
+_TAYLOR_GUESS = 0.25
 
 
 @nb.njit(cache=True)
@@ -233,23 +236,24 @@ def poly_m4(c, b):
 
 
 @nb.njit(cache=True)
-def poly_x_extrema(TW, hs, xmax, xmin, cv):
+def poly_x_extrema(TW, hs, xmax, xmin, cv, rho):
     """(xmax, xmin) with the interior extrema of X = z[0] on the piece [0, hs]: where
-    V = z[0]' changes sign between X_SAMPLES + 1 points (a piece spans THETA_POLY = 3 of the
-    fastest rate, so the samples are 3/4 of it apart and V's sign changes about pi: at most
-    one is expected between two of them), located by ``poly_root`` on V (``cv``: work,
-    N_TAYLOR + 1; the kernel lends it the guard's polynomial ``cp``, rebuilt before every
-    use)."""
-    va = poly_component(TW, 0, 0.0)[1]
-    for q in range(1, X_SAMPLES + 1):  # V at X_SAMPLES points: each sign change an extremum
-        vb = poly_component(TW, 0, q * hs / X_SAMPLES)[1]
+    V = z[0]' changes sign between sample points at most THETA_POLY / X_SAMPLES of the fastest
+    rate ``rho`` apart (X_SAMPLES on a full piece, which spans THETA_POLY = 3 of it, so V's
+    sign changes about pi apart: at most one is expected between two samples; fewer on a
+    shorter piece, one interval on a piece cut short by an event), located by ``poly_root`` on
+    V (``cv``: work, N_TAYLOR + 1; the kernel lends it the guard's polynomial ``cp``, rebuilt
+    before every use)."""
+    ns = min(X_SAMPLES, max(1, int(math.ceil(X_SAMPLES * rho * hs / THETA_POLY - 1e-9))))
+    va = TW[0, 1]  # V at 0 (= poly_component(TW, 0, 0.0)[1], bit for bit)
+    for q in range(1, ns + 1):  # V at ns points: each sign change an extremum
+        vb = poly_component(TW, 0, q * hs / ns)[1]
         if va * vb < 0.0:
             sg = 1.0 if va >= 0.0 else -1.0  # g = sg V >= 0 at the lower end
             for j in range(N_TAYLOR):
                 cv[j] = sg * (j + 1) * TW[0, j + 1]
             cv[N_TAYLOR] = 0.0
-            lo, hi = poly_root(cv, hs, (q - 1) / X_SAMPLES, q / X_SAMPLES, sg * va, sg * vb,
-                               1e-15)
+            lo, hi = poly_root(cv, hs, (q - 1) / ns, q / ns, sg * va, sg * vb, 1e-15)
             x = poly_component(TW, 0, 0.5 * (lo + hi) * hs)[0]
             xmax = max(xmax, x)
             xmin = min(xmin, x)
@@ -277,6 +281,34 @@ def poly_tangent(PW, n, h, Y, E, t):
             Y[a, col] = t[a]
 
 
+@nb.njit(cache=True, inline="always")
+def _taylor_guess(a, b, c, d):
+    """The smallest positive root of the cubic a + b s + c s^2 + d s^3 (a >= 0) near 0: the
+    quadratic's smallest positive root (stable form), then one Newton step on the cubic; 0.0
+    when the quadratic has none."""
+    if a == 0.0:  # on the surface: the root of (p - a) / s, if p moves in (b > 0)
+        s = -b / c if b > 0.0 and c != 0.0 else 0.0
+    elif c == 0.0:
+        s = -a / b if b != 0.0 else 0.0
+    else:
+        disc = b * b - 4.0 * a * c
+        if disc < 0.0:
+            return 0.0
+        q = -0.5 * (b + math.copysign(math.sqrt(disc), b))
+        r1 = q / c
+        r2 = a / q if q != 0.0 else 0.0
+        if r1 > 0.0 and r2 > 0.0:
+            s = min(r1, r2)
+        else:
+            s = max(r1, r2)
+    if not s > 0.0:
+        return 0.0
+    dp = b + s * (2.0 * c + 3.0 * s * d)
+    if dp != 0.0:
+        s -= (a + s * (b + s * (c + s * d))) / dp
+    return s
+
+
 @nb.njit(cache=True)
 def poly_root(c, hs, lo, hi, glo, ghi, tol):
     """The bracket [lo, hi] (fractions of the piece of length hs; p(lo hs) = glo >= 0 >
@@ -287,7 +319,16 @@ def poly_root(c, hs, lo, hi, glo, ghi, tol):
     H(u) / u, so that the Hermite's root at the bracket's start does not attract it) and kept
     inside the bracket; a step that leaves it or does not halve the previous one is replaced by
     the bracket's midpoint. Converged, an iterate steps tol / 2 past the root so that the
-    bracket closes from both sides. Returns (lo, hi)."""
+    bracket closes from both sides. Returns (lo, hi).
+
+    A bracket that starts at the piece's start (lo = 0) with a root in its first
+    ``_TAYLOR_GUESS`` of the piece (a short flight, a bounce of a chattering sequence) starts
+    Newton from the root of p's own Taylor cubic at 0 instead (``_taylor_guess``): the
+    Hermite over the whole bracket would guess a root at a small fraction of it poorly."""
+    if lo == 0.0:
+        x = _taylor_guess(glo, c[1], c[2], c[3]) / hs
+        if 0.0 < x < min(hi, _TAYLOR_GUESS):
+            return _newton_root(c, hs, lo, hi, x, tol)
     L = (hi - lo) * hs
     dlo = pval(c, lo * hs)[1] * L
     dhi = pval(c, hi * hs)[1] * L
@@ -321,6 +362,12 @@ def poly_root(c, hs, lo, hi, glo, ghi, tol):
     x = lo + u * (hi - lo)
     if not lo < x < hi:
         x = 0.5 * (lo + hi)
+    return _newton_root(c, hs, lo, hi, x, tol)
+
+
+@nb.njit(cache=True, inline="always")
+def _newton_root(c, hs, lo, hi, x, tol):
+    """``poly_root``'s Newton iteration from the first guess x inside (lo, hi)."""
     dx_old = math.inf
     for _ in range(200):
         g, d = pval(c, x * hs)
