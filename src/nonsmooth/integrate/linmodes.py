@@ -35,7 +35,8 @@ POLY_DEPTH = 30  # halvings of a piece in its exit test (<= hybrid.SCAN_DEPTH: i
 X_SAMPLES = 4  # samples of V per piece for the extrema of X
 _HERMITE_TOL = 1e-9  # the first guess of ``poly_root``: fraction of its bracket
 #: ``poly_root`` starts from the Taylor cubic's root when that lies in this first fraction of
-#: the piece (rho s <= 0.75 on a full piece: the cubic then guesses the root to about 1 %)
+#: the piece (rho s <= 0.75 on a full piece, where the terms past the cubic are small: on a
+#: ball's bounce the guess is then within about 1 % and Newton needs 2-3 evaluations)
 _TAYLOR_GUESS = 0.25
 
 
@@ -286,7 +287,7 @@ def _taylor_guess(a, b, c, d):
     """The smallest positive root of the cubic a + b s + c s^2 + d s^3 (a >= 0) near 0: the
     quadratic's smallest positive root (stable form), then one Newton step on the cubic; 0.0
     when the quadratic has none."""
-    if a == 0.0:  # on the surface: the root of (p - a) / s, if p moves in (b > 0)
+    if a == 0.0:  # on the surface: the root of p(s) / s, if p moves in (b > 0)
         s = -b / c if b > 0.0 and c != 0.0 else 0.0
     elif c == 0.0:
         s = -a / b if b != 0.0 else 0.0
