@@ -632,12 +632,11 @@ def test_series_root_and_extrema_against_closed_forms():
     cp = np.zeros(N_TAYLOR + 1)
     cv = np.zeros(N_TAYLOR + 1)
     taken = set()
+    mp = mpmath.mp.clone()
+    mp.dps = 40
     for z0, v0, ph in ((0.0, 1e-6, 0.3), (0.0, 1e-3, 2.5), (0.0, 0.02, 0.3), (1e-6, -1e-3, 2.5),
                        (0.0, 0.1, 2.5), (0.02, 0.3, 4.0)):
         C, S = math.cos(ph), math.sin(ph)
-
-        mp = mpmath.mp.clone()
-        mp.dps = 40
         mC, mS, mph = mp.cos(ph), mp.sin(ph), mp.mpf(ph)
 
         def z(t):  # the closed form of Z from (z0, v0) at phase ph
