@@ -892,32 +892,154 @@ def _cf_state(MC, mode, om, y0, z0, C, S, hs, u1, f1):
 
 # ---- tangent (variational) dynamics ---------------------------------------------------------
 @nb.njit(cache=True, inline="always", fastmath=_FM)
+def _stage_phase(i, c2, s2, c3, s3, c4, s4, c8, s8, c12, s12):
+    """(cos, sin) of the forcing-phase advance to RKF45 stage i (times 0, 1/4, 3/8, 12/13, 1,
+    1/2 of the step), from ``_stage_rotations``."""
+    if i == 0:
+        return 1.0, 0.0
+    if i == 1:
+        return c2, s2
+    if i == 2:
+        return c3, s3
+    if i == 3:
+        return c12, s12
+    if i == 4:
+        return c8, s8
+    return c4, s4
+
+
+@nb.njit(cache=True, inline="always", fastmath=_FM)
+def _jy2(JS, i, w0, w1, Y, c, ncm):
+    """J Y of stage i for two states (``_rk_tangent2``): rows 0, 1 of the stage's Jacobian
+    JS[i] on (w0, w1) and on the column's memory rows Y[2:, c]."""
+    acc0 = 0.0
+    acc0 += JS[i, 0, 0] * w0
+    acc0 += JS[i, 0, 1] * w1
+    acc1 = 0.0
+    acc1 += JS[i, 1, 0] * w0
+    acc1 += JS[i, 1, 1] * w1
+    for q in range(ncm):
+        yq = Y[2 + q, c]
+        acc0 += JS[i, 0, 2 + q] * yq
+        acc1 += JS[i, 1, 2 + q] * yq
+    return acc0, acc1
+
+
+@nb.njit(cache=True, inline="always", fastmath=_FM)
+def _rk_tangent2(jacobian, mode, tau, C, S, h, om, u, k0, k1, k2, k3, k4, pp, mem, Y, J, JS, us,
+                 cmi, rtol, atol):
+    """``_rk_tangent`` for two states: the Jacobian at the six stage states first (into JS,
+    stage x row x column: the state's two, then one per continuous memory slot), then each
+    tangent column's stages with the same formulas in scalars, without the stage array KY
+    (fastmath's reassociation may round them differently in the last bit)."""
+    m = Y.shape[1]
+    ncm = len(cmi)
+    c2, s2, c3, s3, c4, s4, c8, s8, c12, s12 = _stage_rotations(om, h)
+    for i in range(_NS):
+        cw, sw = _stage_phase(i, c2, s2, c3, s3, c4, s4, c8, s8, c12, s12)
+        a0, a1, a2, a3, a4 = _A[i, 0], _A[i, 1], _A[i, 2], _A[i, 3], _A[i, 4]
+        for r in range(2):
+            us[r] = u[r] + h * (a0 * k0[r] + a1 * k1[r] + a2 * k2[r] + a3 * k3[r] + a4 * k4[r])
+        for q in range(ncm):
+            J[0, 2 + cmi[q]] = 0.0
+            J[1, 2 + cmi[q]] = 0.0
+        jacobian(mode, tau + _C[i] * h, C * cw - S * sw, S * cw + C * sw, us, pp, mem, J)
+        JS[i, 0, 0] = J[0, 0]
+        JS[i, 0, 1] = J[0, 1]
+        JS[i, 1, 0] = J[1, 0]
+        JS[i, 1, 1] = J[1, 1]
+        for q in range(ncm):
+            JS[i, 0, 2 + q] = J[0, 2 + cmi[q]]
+            JS[i, 1, 2 + q] = J[1, 2 + cmi[q]]
+    err2 = 0.0
+    for c in range(m):
+        y0 = Y[0, c]
+        y1 = Y[1, c]
+        s0 = 0.0
+        s1 = 0.0
+        p0, p1 = _jy2(JS, 0, y0 + h * s0, y1 + h * s1, Y, c, ncm)
+        s0 = 0.0
+        s0 += _A[1, 0] * p0
+        s1 = 0.0
+        s1 += _A[1, 0] * p1
+        q0, q1 = _jy2(JS, 1, y0 + h * s0, y1 + h * s1, Y, c, ncm)
+        s0 = 0.0
+        s0 += _A[2, 0] * p0
+        s0 += _A[2, 1] * q0
+        s1 = 0.0
+        s1 += _A[2, 0] * p1
+        s1 += _A[2, 1] * q1
+        r0, r1 = _jy2(JS, 2, y0 + h * s0, y1 + h * s1, Y, c, ncm)
+        s0 = 0.0
+        s0 += _A[3, 0] * p0
+        s0 += _A[3, 1] * q0
+        s0 += _A[3, 2] * r0
+        s1 = 0.0
+        s1 += _A[3, 0] * p1
+        s1 += _A[3, 1] * q1
+        s1 += _A[3, 2] * r1
+        t0, t1 = _jy2(JS, 3, y0 + h * s0, y1 + h * s1, Y, c, ncm)
+        s0 = 0.0
+        s0 += _A[4, 0] * p0
+        s0 += _A[4, 1] * q0
+        s0 += _A[4, 2] * r0
+        s0 += _A[4, 3] * t0
+        s1 = 0.0
+        s1 += _A[4, 0] * p1
+        s1 += _A[4, 1] * q1
+        s1 += _A[4, 2] * r1
+        s1 += _A[4, 3] * t1
+        v0, v1 = _jy2(JS, 4, y0 + h * s0, y1 + h * s1, Y, c, ncm)
+        s0 = 0.0
+        s0 += _A[5, 0] * p0
+        s0 += _A[5, 1] * q0
+        s0 += _A[5, 2] * r0
+        s0 += _A[5, 3] * t0
+        s0 += _A[5, 4] * v0
+        s1 = 0.0
+        s1 += _A[5, 0] * p1
+        s1 += _A[5, 1] * q1
+        s1 += _A[5, 2] * r1
+        s1 += _A[5, 3] * t1
+        s1 += _A[5, 4] * v1
+        z0, z1 = _jy2(JS, 5, y0 + h * s0, y1 + h * s1, Y, c, ncm)
+        n0 = y0 + h * (_B[0] * p0 + _B[1] * q0 + _B[2] * r0 + _B[3] * t0 + _B[4] * v0
+                       + _B[5] * z0)
+        n1 = y1 + h * (_B[0] * p1 + _B[1] * q1 + _B[2] * r1 + _B[3] * t1 + _B[4] * v1
+                       + _B[5] * z1)
+        Y[0, c] = n0
+        Y[1, c] = n1
+        scale = 0.0
+        scale = max(scale, abs(n0))
+        scale = max(scale, abs(n1))
+        sc = atol + rtol * scale
+        e = h * (_E[0] * p0 + _E[2] * r0 + _E[3] * t0 + _E[4] * v0 + _E[5] * z0) / sc
+        err2 += e * e
+        e = h * (_E[0] * p1 + _E[2] * r1 + _E[3] * t1 + _E[4] * v1 + _E[5] * z1) / sc
+        err2 += e * e
+    return err2 / max(m * 2, 1)
+
+
+@nb.njit(cache=True, inline="always", fastmath=_FM)
 def _rk_tangent(jacobian, mode, tau, C, S, h, om, n, u, k0, k1, k2, k3, k4, k5, pp, mem, Y, W, KY,
-                J, us, cmi, rtol, atol):
+                J, JS, us, cmi, rtol, atol):
     """Propagate the tangent Y (rows: u, then the continuous memory slots ``cmi``) through the
     RKF45 step just taken (its stages k0..k5, length h): the same Runge-Kutta formula applied
     to the variational equation Y' = J Y with J the model's Jacobian at each stage state, i.e.
     the exact derivative of the discrete step (internal differentiation). Memory rows are
     constant within a mode; J's columns n + slot give the field's dependence on memory.
     Returns the squared RMS norm of the step's embedded error estimate on the tangent, each
-    column scaled by atol + rtol max|column| (the step-size control takes it with the state's)."""
+    column scaled by atol + rtol max|column| (the step-size control takes it with the state's).
+    Two states: ``_rk_tangent2``."""
+    if n == 2:
+        return _rk_tangent2(jacobian, mode, tau, C, S, h, om, u, k0, k1, k2, k3, k4, pp, mem, Y,
+                            J, JS, us, cmi, rtol, atol)
     m = Y.shape[1]
     ncm = len(cmi)
     # forcing phase at the stage times 0, 1/4, 3/8, 12/13, 1, 1/2 of the step
     c2, s2, c3, s3, c4, s4, c8, s8, c12, s12 = _stage_rotations(om, h)
     for i in range(_NS):
-        if i == 0:
-            cw, sw = 1.0, 0.0
-        elif i == 1:
-            cw, sw = c2, s2
-        elif i == 2:
-            cw, sw = c3, s3
-        elif i == 3:
-            cw, sw = c12, s12
-        elif i == 4:
-            cw, sw = c8, s8
-        else:
-            cw, sw = c4, s4
+        cw, sw = _stage_phase(i, c2, s2, c3, s3, c4, s4, c8, s8, c12, s12)
         a0, a1, a2, a3, a4 = _A[i, 0], _A[i, 1], _A[i, 2], _A[i, 3], _A[i, 4]
         for r in range(n):  # the stage state (_A is strictly lower triangular)
             us[r] = u[r] + h * (a0 * k0[r] + a1 * k1[r] + a2 * k2[r] + a3 * k3[r] + a4 * k4[r])
@@ -925,32 +1047,6 @@ def _rk_tangent(jacobian, mode, tau, C, S, h, om, n, u, k0, k1, k2, k3, k4, k5, 
             for r in range(n):
                 J[r, n + cmi[q]] = 0.0
         jacobian(mode, tau + _C[i] * h, C * cw - S * sw, S * cw + C * sw, us, pp, mem, J)
-        if n == 2:  # the same arithmetic in scalars (most models): tiny loops cost more
-            j00 = J[0, 0]
-            j01 = J[0, 1]
-            j10 = J[1, 0]
-            j11 = J[1, 1]
-            for c in range(m):
-                s0 = 0.0
-                s1 = 0.0
-                for j in range(i):
-                    s0 += _A[i, j] * KY[j, 0, c]
-                    s1 += _A[i, j] * KY[j, 1, c]
-                w0 = Y[0, c] + h * s0
-                w1 = Y[1, c] + h * s1
-                acc0 = 0.0
-                acc0 += j00 * w0
-                acc0 += j01 * w1
-                acc1 = 0.0
-                acc1 += j10 * w0
-                acc1 += j11 * w1
-                for q in range(ncm):
-                    yq = Y[2 + q, c]
-                    acc0 += J[0, 2 + cmi[q]] * yq
-                    acc1 += J[1, 2 + cmi[q]] * yq
-                KY[i, 0, c] = acc0
-                KY[i, 1, c] = acc1
-            continue
         for c in range(m):
             for r in range(n):  # the stages before this one (_A is strictly lower triangular)
                 acc = 0.0
@@ -1145,6 +1241,7 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
     m3 = n + 3
     sizes = (len(p), 10 * n, nme, MAX_GUARDS * (n + 3), MAX_MODES * (N_MC + 7), nlin,
              N_BD * (1 + MAX_GUARDS), (SCAN_DEPTH + 1) * 5, _NS * nt * mt, 6 * nt + nt * nj,
+             _NS * 2 * nj if nt == 2 else 0,
              2 * nme if tan else 0, len(cmi), mt, n + 1,
              MAX_MODES + (N_TAYLOR + 1) * (m3 + 1) + n * n + n + 2 * MAX_GUARDS)
     total = 0
@@ -1186,6 +1283,9 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
     W, ue, fm, gk, uc, ua = rows[0], rows[1], rows[2], rows[3], rows[4], rows[5]
     J = view(ws, o + 6 * nt, (nt, nj))
     o += 6 * nt + nt * nj
+    njs = 2 if nt == 2 else 0
+    JS = view(ws, o, (_NS, njs, nj))  # the Jacobian at the stages of a two-state tangent step
+    o += _NS * njs * nj
     nmt = nme if tan else 0
     me = view(ws, o, (nmt,))
     mc = view(ws, o + nmt, (nmt,))
@@ -1538,8 +1638,8 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
                         poly_tangent(PW[mode], n, hs, Y, PE, pt)
                     else:
                         errY2 = _rk_tangent(jacobian, mode, tau, C, S, hs, om, n, u, f0, k1, k2,
-                                            k3, k4, k5, pp, mem, Y, W, KY, J, us, cmi, rtol,
-                                            atol)
+                                            k3, k4, k5, pp, mem, Y, W, KY, J, JS, us, cmi,
+                                            rtol, atol)
                 if k_tr < 0 and not cf and not pm:
                     # step-size control after an accepted step without a switch; with tangent
                     # vectors, also by their error (at rest the state's estimate is 0, and a
