@@ -1021,6 +1021,181 @@ def _rk_tangent2(jacobian, mode, tau, C, S, h, om, u, k0, k1, k2, k3, k4, pp, me
 
 
 @nb.njit(cache=True, inline="always", fastmath=_FM)
+def _jy4(JS, i, w0, w1, w2, w3, Y, c, ncm):
+    """J Y of stage i for four states (``_rk_tangent4``), as ``_jy2``."""
+    acc0 = 0.0
+    acc0 += JS[i, 0, 0] * w0
+    acc0 += JS[i, 0, 1] * w1
+    acc0 += JS[i, 0, 2] * w2
+    acc0 += JS[i, 0, 3] * w3
+    acc1 = 0.0
+    acc1 += JS[i, 1, 0] * w0
+    acc1 += JS[i, 1, 1] * w1
+    acc1 += JS[i, 1, 2] * w2
+    acc1 += JS[i, 1, 3] * w3
+    acc2 = 0.0
+    acc2 += JS[i, 2, 0] * w0
+    acc2 += JS[i, 2, 1] * w1
+    acc2 += JS[i, 2, 2] * w2
+    acc2 += JS[i, 2, 3] * w3
+    acc3 = 0.0
+    acc3 += JS[i, 3, 0] * w0
+    acc3 += JS[i, 3, 1] * w1
+    acc3 += JS[i, 3, 2] * w2
+    acc3 += JS[i, 3, 3] * w3
+    for q in range(ncm):
+        yq = Y[4 + q, c]
+        acc0 += JS[i, 0, 4 + q] * yq
+        acc1 += JS[i, 1, 4 + q] * yq
+        acc2 += JS[i, 2, 4 + q] * yq
+        acc3 += JS[i, 3, 4 + q] * yq
+    return acc0, acc1, acc2, acc3
+
+
+@nb.njit(cache=True, inline="always", fastmath=_FM)
+def _rk_tangent4(jacobian, mode, tau, C, S, h, om, u, k0, k1, k2, k3, k4, pp, mem, Y, J, JS, us,
+                 cmi, rtol, atol):
+    """``_rk_tangent`` for four states (a rotor, two masses), as ``_rk_tangent2``: the Jacobian
+    at the six stage states first, then each column's stages in scalars."""
+    m = Y.shape[1]
+    ncm = len(cmi)
+    c2, s2, c3, s3, c4, s4, c8, s8, c12, s12 = _stage_rotations(om, h)
+    for i in range(_NS):
+        cw, sw = _stage_phase(i, c2, s2, c3, s3, c4, s4, c8, s8, c12, s12)
+        a0, a1, a2, a3, a4 = _A[i, 0], _A[i, 1], _A[i, 2], _A[i, 3], _A[i, 4]
+        for r in range(4):
+            us[r] = u[r] + h * (a0 * k0[r] + a1 * k1[r] + a2 * k2[r] + a3 * k3[r] + a4 * k4[r])
+        for q in range(ncm):
+            for r in range(4):
+                J[r, 4 + cmi[q]] = 0.0
+        jacobian(mode, tau + _C[i] * h, C * cw - S * sw, S * cw + C * sw, us, pp, mem, J)
+        for r in range(4):
+            for q in range(4):
+                JS[i, r, q] = J[r, q]
+            for q in range(ncm):
+                JS[i, r, 4 + q] = J[r, 4 + cmi[q]]
+    err2 = 0.0
+    for c in range(m):
+        y0 = Y[0, c]
+        y1 = Y[1, c]
+        y2 = Y[2, c]
+        y3 = Y[3, c]
+        s0 = 0.0
+        s1 = 0.0
+        s2 = 0.0
+        s3 = 0.0
+        p0, p1, p2, p3 = _jy4(JS, 0, y0 + h * s0, y1 + h * s1, y2 + h * s2, y3 + h * s3, Y, c, ncm)
+        s0 = 0.0
+        s0 += _A[1, 0] * p0
+        s1 = 0.0
+        s1 += _A[1, 0] * p1
+        s2 = 0.0
+        s2 += _A[1, 0] * p2
+        s3 = 0.0
+        s3 += _A[1, 0] * p3
+        q0, q1, q2, q3 = _jy4(JS, 1, y0 + h * s0, y1 + h * s1, y2 + h * s2, y3 + h * s3, Y, c, ncm)
+        s0 = 0.0
+        s0 += _A[2, 0] * p0
+        s0 += _A[2, 1] * q0
+        s1 = 0.0
+        s1 += _A[2, 0] * p1
+        s1 += _A[2, 1] * q1
+        s2 = 0.0
+        s2 += _A[2, 0] * p2
+        s2 += _A[2, 1] * q2
+        s3 = 0.0
+        s3 += _A[2, 0] * p3
+        s3 += _A[2, 1] * q3
+        r0, r1, r2, r3 = _jy4(JS, 2, y0 + h * s0, y1 + h * s1, y2 + h * s2, y3 + h * s3, Y, c, ncm)
+        s0 = 0.0
+        s0 += _A[3, 0] * p0
+        s0 += _A[3, 1] * q0
+        s0 += _A[3, 2] * r0
+        s1 = 0.0
+        s1 += _A[3, 0] * p1
+        s1 += _A[3, 1] * q1
+        s1 += _A[3, 2] * r1
+        s2 = 0.0
+        s2 += _A[3, 0] * p2
+        s2 += _A[3, 1] * q2
+        s2 += _A[3, 2] * r2
+        s3 = 0.0
+        s3 += _A[3, 0] * p3
+        s3 += _A[3, 1] * q3
+        s3 += _A[3, 2] * r3
+        t0, t1, t2, t3 = _jy4(JS, 3, y0 + h * s0, y1 + h * s1, y2 + h * s2, y3 + h * s3, Y, c, ncm)
+        s0 = 0.0
+        s0 += _A[4, 0] * p0
+        s0 += _A[4, 1] * q0
+        s0 += _A[4, 2] * r0
+        s0 += _A[4, 3] * t0
+        s1 = 0.0
+        s1 += _A[4, 0] * p1
+        s1 += _A[4, 1] * q1
+        s1 += _A[4, 2] * r1
+        s1 += _A[4, 3] * t1
+        s2 = 0.0
+        s2 += _A[4, 0] * p2
+        s2 += _A[4, 1] * q2
+        s2 += _A[4, 2] * r2
+        s2 += _A[4, 3] * t2
+        s3 = 0.0
+        s3 += _A[4, 0] * p3
+        s3 += _A[4, 1] * q3
+        s3 += _A[4, 2] * r3
+        s3 += _A[4, 3] * t3
+        v0, v1, v2, v3 = _jy4(JS, 4, y0 + h * s0, y1 + h * s1, y2 + h * s2, y3 + h * s3, Y, c, ncm)
+        s0 = 0.0
+        s0 += _A[5, 0] * p0
+        s0 += _A[5, 1] * q0
+        s0 += _A[5, 2] * r0
+        s0 += _A[5, 3] * t0
+        s0 += _A[5, 4] * v0
+        s1 = 0.0
+        s1 += _A[5, 0] * p1
+        s1 += _A[5, 1] * q1
+        s1 += _A[5, 2] * r1
+        s1 += _A[5, 3] * t1
+        s1 += _A[5, 4] * v1
+        s2 = 0.0
+        s2 += _A[5, 0] * p2
+        s2 += _A[5, 1] * q2
+        s2 += _A[5, 2] * r2
+        s2 += _A[5, 3] * t2
+        s2 += _A[5, 4] * v2
+        s3 = 0.0
+        s3 += _A[5, 0] * p3
+        s3 += _A[5, 1] * q3
+        s3 += _A[5, 2] * r3
+        s3 += _A[5, 3] * t3
+        s3 += _A[5, 4] * v3
+        z0, z1, z2, z3 = _jy4(JS, 5, y0 + h * s0, y1 + h * s1, y2 + h * s2, y3 + h * s3, Y, c, ncm)
+        n0 = y0 + h * (_B[0] * p0 + _B[1] * q0 + _B[2] * r0 + _B[3] * t0 + _B[4] * v0 + _B[5] * z0)
+        n1 = y1 + h * (_B[0] * p1 + _B[1] * q1 + _B[2] * r1 + _B[3] * t1 + _B[4] * v1 + _B[5] * z1)
+        n2 = y2 + h * (_B[0] * p2 + _B[1] * q2 + _B[2] * r2 + _B[3] * t2 + _B[4] * v2 + _B[5] * z2)
+        n3 = y3 + h * (_B[0] * p3 + _B[1] * q3 + _B[2] * r3 + _B[3] * t3 + _B[4] * v3 + _B[5] * z3)
+        Y[0, c] = n0
+        Y[1, c] = n1
+        Y[2, c] = n2
+        Y[3, c] = n3
+        scale = 0.0
+        scale = max(scale, abs(n0))
+        scale = max(scale, abs(n1))
+        scale = max(scale, abs(n2))
+        scale = max(scale, abs(n3))
+        sc = atol + rtol * scale
+        e = h * (_E[0] * p0 + _E[2] * r0 + _E[3] * t0 + _E[4] * v0 + _E[5] * z0) / sc
+        err2 += e * e
+        e = h * (_E[0] * p1 + _E[2] * r1 + _E[3] * t1 + _E[4] * v1 + _E[5] * z1) / sc
+        err2 += e * e
+        e = h * (_E[0] * p2 + _E[2] * r2 + _E[3] * t2 + _E[4] * v2 + _E[5] * z2) / sc
+        err2 += e * e
+        e = h * (_E[0] * p3 + _E[2] * r3 + _E[3] * t3 + _E[4] * v3 + _E[5] * z3) / sc
+        err2 += e * e
+    return err2 / max(m * 4, 1)
+
+
+@nb.njit(cache=True, inline="always", fastmath=_FM)
 def _rk_tangent(jacobian, mode, tau, C, S, h, om, n, u, k0, k1, k2, k3, k4, k5, pp, mem, Y, W, KY,
                 J, JS, us, cmi, rtol, atol):
     """Propagate the tangent Y (rows: u, then the continuous memory slots ``cmi``) through the
@@ -1030,9 +1205,12 @@ def _rk_tangent(jacobian, mode, tau, C, S, h, om, n, u, k0, k1, k2, k3, k4, k5, 
     constant within a mode; J's columns n + slot give the field's dependence on memory.
     Returns the squared RMS norm of the step's embedded error estimate on the tangent, each
     column scaled by atol + rtol max|column| (the step-size control takes it with the state's).
-    Two states: ``_rk_tangent2``."""
+    Two and four states: ``_rk_tangent2``, ``_rk_tangent4``."""
     if n == 2:
         return _rk_tangent2(jacobian, mode, tau, C, S, h, om, u, k0, k1, k2, k3, k4, pp, mem, Y,
+                            J, JS, us, cmi, rtol, atol)
+    if n == 4:
+        return _rk_tangent4(jacobian, mode, tau, C, S, h, om, u, k0, k1, k2, k3, k4, pp, mem, Y,
                             J, JS, us, cmi, rtol, atol)
     m = Y.shape[1]
     ncm = len(cmi)
@@ -1241,7 +1419,7 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
     m3 = n + 3
     sizes = (len(p), 10 * n, nme, MAX_GUARDS * (n + 3), MAX_MODES * (N_MC + 7), nlin,
              N_BD * (1 + MAX_GUARDS), (SCAN_DEPTH + 1) * 5, _NS * nt * mt, 6 * nt + nt * nj,
-             _NS * 2 * nj if nt == 2 else 0,
+             _NS * nt * nj if nt == 2 or nt == 4 else 0,
              2 * nme if tan else 0, len(cmi), mt, n + 1,
              MAX_MODES + (N_TAYLOR + 1) * (m3 + 1) + n * n + n + 2 * MAX_GUARDS)
     total = 0
@@ -1283,8 +1461,8 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
     W, ue, fm, gk, uc, ua = rows[0], rows[1], rows[2], rows[3], rows[4], rows[5]
     J = view(ws, o + 6 * nt, (nt, nj))
     o += 6 * nt + nt * nj
-    njs = 2 if nt == 2 else 0
-    JS = view(ws, o, (_NS, njs, nj))  # the Jacobian at the stages of a two-state tangent step
+    njs = nt if nt == 2 or nt == 4 else 0
+    JS = view(ws, o, (_NS, njs, nj))  # the Jacobian at the stages of a 2- or 4-state tangent step
     o += _NS * njs * nj
     nmt = nme if tan else 0
     me = view(ws, o, (nmt,))
