@@ -27,7 +27,7 @@ from nonsmooth.integrate.contract import (  # noqa: E402
     ST_V,
     ST_X,
 )
-from nonsmooth.integrate.hybrid import advance_generic  # noqa: E402
+from nonsmooth.integrate.hybrid import _NS, _rk_step, _rk_tangent, advance_generic  # noqa: E402
 
 pytestmark = pytest.mark.filterwarnings("ignore::numba.NumbaExperimentalFeatureWarning")
 
@@ -666,3 +666,83 @@ def test_series_root_and_extrema_against_closed_forms():
             xmax, _ = poly_x_extrema(TW, t_root, -np.inf, np.inf, cv, rho)
             assert abs(xmax - float(z(t_apex))) <= 1e-17 + 1e-13 * abs(float(z(t_apex)))
     assert taken == {True, False}  # both first guesses were exercised
+
+
+# ---- the RKF45 tangent step is the derivative of the RKF45 step -----------------------------
+@nb.cfunc(FIELD, cache=False)
+def coupled_field(mode, t, c, s, u, p, mem, du):
+    """A nonlinear field of any dimension n that depends on one memory slot."""
+    n = u.shape[0]
+    for i in range(n):
+        a = u[(i + 1) % n]
+        b = u[(i + 2) % n]
+        f = 0.5 * c if i == 0 else 0.4 * s
+        du[i] = -0.2 * u[i] + math.sin(a) + 0.3 * mem[0] * b * b + f
+    return 0
+
+
+@nb.cfunc(JAC, cache=False)
+def coupled_jacobian(mode, t, c, s, u, p, mem, J):
+    n = u.shape[0]
+    for i in range(n):
+        for q in range(n):
+            J[i, q] = 0.0
+    for i in range(n):
+        a = u[(i + 1) % n]
+        b = u[(i + 2) % n]
+        J[i, i] += -0.2
+        J[i, (i + 1) % n] += math.cos(a)
+        J[i, (i + 2) % n] += 0.6 * mem[0] * b
+        J[i, n] = 0.3 * b * b  # d/d mem[0]
+    return 0
+
+
+@nb.njit(cache=False)
+def _rk_step_and_tangent(field, jacobian, u, mem, h, om, Y):
+    """One RKF45 step of ``field`` from (tau, C, S) = (0.3, cos 0.7, sin 0.7) and its tangent
+    (``hybrid._rk_tangent``) applied to Y (rows: u, then the memory slot). Returns the step's
+    end state."""
+    n = u.shape[0]
+    m = Y.shape[1]
+    p = np.zeros(1)
+    C, S = math.cos(0.7), math.sin(0.7)
+    k0, k1, k2, k3, k4, k5 = (np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n),
+                              np.zeros(n))
+    us, u1 = np.zeros(n), np.zeros(n)
+    field(0, 0.3, C, S, u, p, mem, k0)
+    _rk_step(field, 0, 0.3, C, S, h, om, n, u, k0, p, mem, 1e-8, 1e-10, us, k1, k2, k3, k4, k5,
+             u1)
+    cmi = np.zeros(1, np.int64)
+    _rk_tangent(jacobian, 0, 0.3, C, S, h, om, n, u, k0, k1, k2, k3, k4, k5, p, mem, Y,
+                np.zeros(n), np.zeros((_NS, n, m)), np.zeros((n, n + 1)),
+                np.zeros((_NS, n, n + 1)), us, cmi, 1e-8, 1e-10)
+    return u1
+
+
+@pytest.mark.parametrize("n", [2, 3, 4, 5])
+def test_rk_tangent_is_the_derivative_of_the_rk_step(n):
+    """The tangent of an RKF45 step (the two- and four-state paths written in scalars, the
+    general loop for 3 and 5 states), one memory slot as a continuous coordinate, equals central
+    differences of the same step in u and in the slot."""
+    rng = np.random.default_rng(n)
+    u = rng.uniform(-1.0, 1.0, n)
+    mem = np.array([0.8])
+    h, om = 0.37, 1.3
+    Y = np.eye(n + 1)  # every direction: the step's whole Jacobian
+    _rk_step_and_tangent(coupled_field, coupled_jacobian, u, mem, h, om, Y)
+    eps = 1e-6
+    F = np.zeros((n, n + 1))
+    for j in range(n + 1):
+        up, um, mp, mm = u.copy(), u.copy(), mem.copy(), mem.copy()
+        if j < n:
+            up[j] += eps
+            um[j] -= eps
+        else:
+            mp[0] += eps
+            mm[0] -= eps
+        F[:, j] = (_rk_step_and_tangent(coupled_field, coupled_jacobian, up, mp, h, om,
+                                        np.zeros((n + 1, 0)))
+                   - _rk_step_and_tangent(coupled_field, coupled_jacobian, um, mm, h, om,
+                                          np.zeros((n + 1, 0)))) / (2 * eps)
+    assert np.max(np.abs(Y[:n] - F)) <= 1e-8 * np.max(np.abs(F))
+    assert np.array_equal(Y[n], np.eye(n + 1)[n])  # the memory row is constant in a mode
