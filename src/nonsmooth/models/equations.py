@@ -589,6 +589,7 @@ def _source(sp, ctx, states, pnames, mode_names, own, fields, rows, branches, in
             linear, admissible=None) -> str:
     """The Python source of the seven model functions, and of ``admissible(u, p)`` (plain
     Python) where the method has that condition."""
+    from sympy.printing.precedence import PRECEDENCE
     from sympy.printing.pycode import PythonCodePrinter
 
     n = len(states)
@@ -601,6 +602,17 @@ def _source(sp, ctx, states, pnames, mode_names, own, fields, rows, branches, in
 
         def _print_softplus(self, e):
             return f"_softplus({self._print(e.args[0])})"
+
+        def _print_Pow(self, e, rational=False):
+            # x**(k/2) with |k| > 1 (the Jacobian of sqrt(x**2 + y**2), a curved guard's
+            # radius) as x**(k // 2) * sqrt(x): numba's pow(x, 1.5) costs several sqrt
+            b, x = e.args
+            if x.is_Rational and x.q == 2 and abs(x.p) > 1:
+                k = abs(x.p) // 2
+                lead = self._print(b ** k) if k > 1 else self.parenthesize(b, PRECEDENCE["Pow"])
+                r = f"{lead}*math.sqrt({self._print(b)})"
+                return f"({r})" if x.p > 0 else f"(1/({r}))"
+            return super()._print_Pow(e, rational=rational)
 
     printer = Printer({"fully_qualified_modules": True, "standard": "python3"})
 
