@@ -671,18 +671,21 @@ def test_series_root_and_extrema_against_closed_forms():
 # ---- the RKF45 tangent step is the derivative of the RKF45 step -----------------------------
 @nb.cfunc(FIELD, cache=False)
 def coupled_field(mode, t, c, s, u, p, mem, du):
-    """A nonlinear field of any dimension n that depends on one memory slot."""
+    """A nonlinear field of any dimension n that depends on the forcing phase and on memory
+    slot 1 (slot 0 is a discrete flag it ignores)."""
     n = u.shape[0]
     for i in range(n):
         a = u[(i + 1) % n]
         b = u[(i + 2) % n]
         f = 0.5 * c if i == 0 else 0.4 * s
-        du[i] = -0.2 * u[i] + math.sin(a) + 0.3 * mem[0] * b * b + f
+        du[i] = -0.2 * u[i] + math.sin(a) + 0.3 * mem[1] * b * b + f + 0.25 * c * u[i] * u[i]
     return 0
 
 
 @nb.cfunc(JAC, cache=False)
 def coupled_jacobian(mode, t, c, s, u, p, mem, J):
+    """Adds into the memory column (the kernel zeroes it before each call) and writes a
+    column of the discrete slot 0 that the tangent must ignore."""
     n = u.shape[0]
     for i in range(n):
         for q in range(n):
@@ -690,18 +693,19 @@ def coupled_jacobian(mode, t, c, s, u, p, mem, J):
     for i in range(n):
         a = u[(i + 1) % n]
         b = u[(i + 2) % n]
-        J[i, i] += -0.2
+        J[i, i] += -0.2 + 0.5 * c * u[i]
         J[i, (i + 1) % n] += math.cos(a)
-        J[i, (i + 2) % n] += 0.6 * mem[0] * b
-        J[i, n] = 0.3 * b * b  # d/d mem[0]
+        J[i, (i + 2) % n] += 0.6 * mem[1] * b
+        J[i, n + 1] += 0.3 * b * b  # d/d mem[1]
+        J[i, n] = 123.0  # slot 0: not continuous
     return 0
 
 
 @nb.njit(cache=False)
 def _rk_step_and_tangent(field, jacobian, u, mem, h, om, Y):
     """One RKF45 step of ``field`` from (tau, C, S) = (0.3, cos 0.7, sin 0.7) and its tangent
-    (``hybrid._rk_tangent``) applied to Y (rows: u, then the memory slot). Returns the step's
-    end state."""
+    (``hybrid._rk_tangent``, memory slot 1 continuous) applied to Y (rows: u, then slot 1).
+    Returns the step's end state."""
     n = u.shape[0]
     m = Y.shape[1]
     p = np.zeros(1)
@@ -712,21 +716,21 @@ def _rk_step_and_tangent(field, jacobian, u, mem, h, om, Y):
     field(0, 0.3, C, S, u, p, mem, k0)
     _rk_step(field, 0, 0.3, C, S, h, om, n, u, k0, p, mem, 1e-8, 1e-10, us, k1, k2, k3, k4, k5,
              u1)
-    cmi = np.zeros(1, np.int64)
+    cmi = np.ones(1, np.int64)
     _rk_tangent(jacobian, 0, 0.3, C, S, h, om, n, u, k0, k1, k2, k3, k4, k5, p, mem, Y,
-                np.zeros(n), np.zeros((_NS, n, m)), np.zeros((n, n + 1)),
-                np.zeros((_NS, n, n + 1)), us, cmi, 1e-8, 1e-10)
+                np.zeros(n), np.zeros((_NS, n, m)), np.zeros((n, n + 2)),
+                np.zeros((_NS, n, n + 2)), us, cmi, 1e-8, 1e-10)
     return u1
 
 
 @pytest.mark.parametrize("n", [2, 3, 4, 5])
 def test_rk_tangent_is_the_derivative_of_the_rk_step(n):
     """The tangent of an RKF45 step (the two- and four-state paths written in scalars, the
-    general loop for 3 and 5 states), one memory slot as a continuous coordinate, equals central
+    general loop for 3 and 5 states), memory slot 1 as a continuous coordinate, equals central
     differences of the same step in u and in the slot."""
     rng = np.random.default_rng(n)
     u = rng.uniform(-1.0, 1.0, n)
-    mem = np.array([0.8])
+    mem = np.array([1.0, 0.8])
     h, om = 0.37, 1.3
     Y = np.eye(n + 1)  # every direction: the step's whole Jacobian
     _rk_step_and_tangent(coupled_field, coupled_jacobian, u, mem, h, om, Y)
@@ -738,8 +742,8 @@ def test_rk_tangent_is_the_derivative_of_the_rk_step(n):
             up[j] += eps
             um[j] -= eps
         else:
-            mp[0] += eps
-            mm[0] -= eps
+            mp[1] += eps
+            mm[1] -= eps
         F[:, j] = (_rk_step_and_tangent(coupled_field, coupled_jacobian, up, mp, h, om,
                                         np.zeros((n + 1, 0)))
                    - _rk_step_and_tangent(coupled_field, coupled_jacobian, um, mm, h, om,

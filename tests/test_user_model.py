@@ -136,6 +136,15 @@ def test_wrong_jacobian_is_caught_by_the_sample_check(duffing):
     assert "exact.jacobian disagrees with the field" in msg and "J[1,0]" in msg
 
 
+@pytest.mark.parametrize("slots, words", [((0, 0), "names a slot twice"),
+                                           ((1,), "names slots outside 0..0")])
+def test_continuous_memory_names_each_slot_once_and_inside(duffing, slots, words):
+    """A repeated slot would give the tangent kernel more memory columns than slots."""
+    with pytest.raises(ns.ParameterError) as exc:
+        _with(duffing, continuous_memory=slots).fns("exact")
+    assert f"exact.continuous_memory {slots} {words}" in _one_line(exc)
+
+
 def _python_only(x):  # not numba.njit: numba cannot call it from a compiled function
     return {"a": x}["a"]
 

@@ -541,6 +541,11 @@ def _sample_check(model, method, m, fns, max_guards):
                          call_transition)
     n = model.n
     bad = lambda msg: ParameterError(f"model {model.name}: {method}.{msg}")  # noqa: E731
+    cm = tuple(m.continuous_memory)
+    if any(not (isinstance(i, int) and 0 <= i < model.n_memory) for i in cm):
+        raise bad(f"continuous_memory {cm} names slots outside 0..{model.n_memory - 1}")
+    if len(set(cm)) != len(cm):  # (the tangent kernel keeps one column per slot named)
+        raise bad(f"continuous_memory {cm} names a slot twice")
     try:
         p = model.params().pack()
     except ParameterError:
@@ -550,9 +555,6 @@ def _sample_check(model, method, m, fns, max_guards):
     du = np.zeros(n)
     J = np.zeros((n, n + model.n_memory))
     G = np.zeros((max_guards, n + 3))
-    cm = tuple(m.continuous_memory)
-    if any(not (isinstance(i, int) and 0 <= i < model.n_memory) for i in cm):
-        raise bad(f"continuous_memory {cm} names slots outside 0..{model.n_memory - 1}")
     t, c, s = 0.1, math.cos(0.1), math.sin(0.1)
     for mode in (m.modes or tuple(range(len(model.mode_names)))):
         name = model.mode_names[mode]
