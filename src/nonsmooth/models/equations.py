@@ -99,7 +99,7 @@ def model_from_equations(name: str, *, states, parameters, modes: dict | None = 
                          period: str | None = None, forcing_amplitude: str | None = None, description: str = "",
                          flow_is_homeomorphism: bool = False, closed_form: bool = True,
                          rtol: float | None = None, atol: float | None = None,
-                         admissible=None, contact_modes=(), **model_kw) -> Model:
+                         admissible=None, contact_modes=(), memory=None, **model_kw) -> Model:
     """A :class:`Model` from equations (see the module documentation).
 
     ``states``: names, e.g. ``("X", "V")``. ``parameters``: ``{name: default}``,
@@ -121,7 +121,16 @@ def model_from_equations(name: str, *, states, parameters, modes: dict | None = 
     frequency parameter (None: a self-excited system without forcing, whose equations do not
     use t; see ``Model.omega``). ``period``: instead of ``omega``, the parameter that is the
     forcing's period T (a forcing of any periodic form written in t; ``cos(2*pi*t/T)`` and
-    ``sin(2*pi*t/T)`` are the fast harmonic terms). ``contact_modes``: mode names that count as contact. Other keywords
+    ``sin(2*pi*t/T)`` are the fast harmonic terms). ``contact_modes``: mode names that count as contact.
+    ``memory``: named memory slots, ``{name: value at a fresh start}`` (an expression of the
+    state, the parameters and t, e.g. ``{"Va": "V"}``) or a sequence of names (0 at a fresh
+    start): values the trajectory carries from event to event (an entry velocity, which side
+    of a union region holds). Expressions may use them; a reset may set them
+    (``reset={"Va": "V"}``), and so may an ``initial`` entry ``(condition, mode, {"Va":
+    "V"})``. A slot that some mode's field depends on is continuous memory (the tangent
+    dynamics carry it; its Jacobian column is derived); a surface may depend on the other
+    slots only (flags: the tangent cannot follow a surface that moves with a continuous
+    slot), and a mode whose field uses a slot has no closed form. Other keywords
     (``state_units``, ``state_long_names``, ``presets``, ``contact_name``, ``lines``,
     ``references``, ``check``, ...) go to :class:`Model` as they are.
 
@@ -152,11 +161,18 @@ def model_from_equations(name: str, *, states, parameters, modes: dict | None = 
     states = tuple(states)
     params = _parameters(parameters, bad)
     pnames = tuple(q.name for q in params)
-    for nm in states + pnames:
+    memory = _memory(memory, bad)
+    if memory and "n_memory" in model_kw:
+        raise bad("give memory={...} or n_memory, not both")
+    mnames = tuple(memory)
+    for nm in states + pnames + mnames:
         if not nm.isidentifier() or keyword.iskeyword(nm) or nm in _RESERVED:
-            raise bad(f"{nm!r} cannot name a state or parameter (reserved or not an identifier)")
-    if len(set(states + pnames)) != len(states) + len(pnames):
-        raise bad("state and parameter names must all differ")
+            raise bad(f"{nm!r} cannot name a state, parameter or memory slot (reserved or not "
+                      f"an identifier)")
+    if len(set(states + pnames + mnames)) != len(states) + len(pnames) + len(mnames):
+        raise bad("state, parameter and memory names must all differ")
+    if memory:
+        model_kw["n_memory"] = len(memory)
     if period is not None:
         if omega is not None and omega is not _OMEGA:
             raise bad("a forcing has a frequency (omega) or a period (period), not both")
@@ -176,17 +192,19 @@ def model_from_equations(name: str, *, states, parameters, modes: dict | None = 
         if unknown:
             raise bad(f"method {mname}: unknown key {sorted(unknown)[0]!r}")
     key = _derivation_key(name, states, params, methods, omega, period, closed_form,
-                          model_kw.get("n_memory"))
+                          tuple(memory.items()) if memory else model_kw.get("n_memory"))
     derived = _cached_derivation(name, key)
     fresh = derived is None
     if fresh:
         import sympy as sp
-        sym = {nm: sp.Symbol(nm, real=True) for nm in states + pnames}
+        sym = {nm: sp.Symbol(nm, real=True) for nm in states + pnames + mnames}
         t = sp.Symbol("t", real=True)
         C, S = sp.Dummy("cos_omega_t", real=True), sp.Dummy("sin_omega_t", real=True)
         w = sym[omega] if omega is not None else 2 * sp.pi / sym[period] if period else None
         ctx = _Context(sp, sym, t, C, S, w, set(states), name)
         ctx.period = period
+        ctx.memory = [sym[m] for m in mnames]
+        ctx.memory_start = [ctx.parse(v, f"memory {m}") for m, v in memory.items()]
         derived = {mname: _derive(sp, ctx, name, mname, spec, states, pnames, mode_names,
                                   closed_form, bad) for mname, spec in methods.items()}
     built = {mname: _method(name, mname, entry, pnames) for mname, entry in derived.items()}
@@ -277,6 +295,7 @@ def _method(name, mname, entry, pnames) -> Method:
                   closed_form=entry["closed_form"],
                   flow_is_homeomorphism=entry["flow_is_homeomorphism"],
                   modes=tuple(entry["modes"]), rtol=entry["rtol"], atol=entry["atol"],
+                  continuous_memory=tuple(entry.get("continuous_memory", ())),
                   description=entry["description"], **extra)
 
 
@@ -294,6 +313,10 @@ def _derive(sp, ctx, name, mname, spec, states, pnames, mode_names, closed_form,
             raise bad(f"mode {mode}: {len(exprs)} expressions for {n} states")
         fields[mode] = [ctx.parse(e, f"mode {mode}, d{states[i]}/dt")
                         for i, e in enumerate(exprs)]
+    # continuous memory: the slots some field of this method depends on (the tangent carries
+    # them); the others are flags
+    cm = [j for j, m in enumerate(ctx.memory)
+          if any(f.has(m) for fs in fields.values() for f in fs)]
     rows, branches = {}, {}
     for mode, glist in (spec.get("guards") or {}).items():
         if mode not in own:
@@ -302,21 +325,36 @@ def _derive(sp, ctx, name, mname, spec, states, pnames, mode_names, closed_form,
         for j, g in enumerate(glist):
             g = g if isinstance(g, Guard) else Guard(*g)
             where = f"mode {mode}, surface {j}"
-            rows[mode].append(ctx.surface(ctx.parse(g.surface, where), where))
+            surface = ctx.parse(g.surface, where)
+            moving = [ctx.memory[q].name for q in cm if surface.has(ctx.memory[q])]
+            if moving:
+                raise bad(f"{where}: the surface depends on the memory slot {moving[0]!r}, "
+                          f"which a field depends on too (continuous memory): the tangent "
+                          f"dynamics cannot follow a surface that moves with it (a surface may "
+                          f"use flags, memory no field uses)")
+            rows[mode].append(ctx.surface(surface, where))
             branches[mode].append(ctx.branches(g, where, own, mode_names))
-    init = [(ctx.condition(cond, f"initial, condition {i}"), mode_names.index(m))
-            for i, (cond, m) in enumerate(spec.get("initial") or ())
-            if _mode_index(m, own, bad) >= 0]
+    init = []
+    for i, entry in enumerate(spec.get("initial") or ()):
+        if not isinstance(entry, (tuple, list)) or len(entry) not in (2, 3):
+            raise bad(f"initial, entry {i}: (condition, mode) or (condition, mode, {{memory: "
+                      f"value}}), got {entry!r}")
+        _mode_index(entry[1], own, bad)
+        sets = ctx.memory_sets(entry[2] if len(entry) == 3 else None, f"initial, entry {i}")
+        init.append((ctx.condition(entry[0], f"initial, condition {i}"),
+                     mode_names.index(entry[1]), sets))
     # the closed form of linear modes: the oscillator's (n = 2, k > 0) where it applies, else
-    # the general form (any n, any stiffness: ``integrate.linmodes``)
+    # the general form (any n, any stiffness: ``integrate.linmodes``); a field that uses
+    # memory has none (``linear`` sees the parameters only)
     linear = {m: (ctx.linear(fields[m]) if n == 2 else None, ctx.linear_general(fields[m]))
-              for m in own} if closed_form else {}
+              for m in own if not any(f.has(q) for f in fields[m] for q in ctx.memory)
+              } if closed_form else {}
     linear = {m: v for m, v in linear.items() if v[1] is not None}
     text = spec.get("admissible")
     cond = _admissible(ctx, text, bad) if text is not None else None
     try:
         source = _source(sp, ctx, states, pnames, mode_names, own, fields, rows, branches,
-                         init, linear, cond)
+                         init, linear, cond, cm)
     except Exception as exc:  # noqa: BLE001 - an expression SymPy cannot print as Python
         raise bad(f"method {mname}: cannot generate its functions "
                   f"({type(exc).__name__}: {str(exc).splitlines()[0] if str(exc) else ''})"
@@ -325,7 +363,7 @@ def _derive(sp, ctx, name, mname, spec, states, pnames, mode_names, closed_form,
     if mname == "exact" and rtol is None and atol is None \
             and not all(m in linear for m in own):
         rtol, atol = EXACT_RTOL, EXACT_ATOL  # nonlinear modes of an exact method: RKF45, tight
-    return {"source": source, "closed_form": bool(linear),
+    return {"source": source, "closed_form": bool(linear), "continuous_memory": cm,
             "curved": any(not isinstance(r, list) for rs in rows.values() for r in rs),
             "flow_is_homeomorphism": bool(spec.get("flow_is_homeomorphism", False)),
             "modes": [mode_names.index(m) for m in own],
@@ -396,6 +434,21 @@ def _parameters(parameters, bad) -> tuple:
     return out
 
 
+def _memory(memory, bad) -> dict:
+    """``memory=`` as {name: value at a fresh start} (a sequence of names: 0 each)."""
+    if memory is None:
+        return {}
+    if isinstance(memory, str):
+        memory = (memory,)
+    if isinstance(memory, dict):
+        return dict(memory)
+    try:
+        return {m: 0 for m in memory}
+    except TypeError:
+        raise bad("memory: a dict {name: value at a fresh start} or a sequence of names") \
+            from None
+
+
 def _mode_index(m, mode_names, bad) -> int:
     if m not in mode_names:
         raise bad(f"unknown mode {m!r} (modes: {', '.join(mode_names)})")
@@ -410,6 +463,8 @@ class _Context:
         self.states = [sym[k] for k in sym if k in states]
         self.omega, self.name = omega, name
         self.period = None  # the forcing period's parameter name, where the model has one
+        self.memory = []  # memory slots' symbols (in slot order)
+        self.memory_start = []  # their values at a fresh start
         self.local = {**sym, "t": t, "pi": sp.pi, **{f: getattr(sp, f) for f in FUNCTIONS},
                       **_smooth_steps(sp)}
 
@@ -441,7 +496,8 @@ class _Context:
         known = set(self.sym.values()) | {self.t}
         unknown = sorted(s.name for s in expr.free_symbols if s not in known)
         if unknown:
-            raise self.bad(f"{where}: unknown name {unknown[0]!r} (states and parameters: "
+            raise self.bad(f"{where}: unknown name {unknown[0]!r} (states and parameters"
+                           f"{' and memory' if self.memory else ''}: "
                            f"{', '.join(k for k in self.sym)}; and t)")
         for pw in expr.atoms(sp.Piecewise):
             if not any(c is sp.true for _, c in pw.args):
@@ -529,13 +585,26 @@ class _Context:
                 raise self.bad(f"{where}: unknown mode {mode!r} (modes: {', '.join(own)})")
             cond = self.sp.true if cond in (True, "True") else self.condition(
                 cond, f"{where}, condition {i}")
-            names = [s.name for s in self.states]
+            names = [s.name for s in self.states] + [m.name for m in self.memory]
             rs = {}
             for k, v in reset.items():
                 if k not in names:
-                    raise self.bad(f"{where}: reset of {k!r}, which is not a state")
+                    raise self.bad(f"{where}: reset of {k!r}, which is neither a state nor a "
+                                   f"memory slot")
                 rs[names.index(k)] = self.parse(v, f"{where}, reset of {k}")
             out.append((cond, mode_names.index(mode), rs))
+        return out
+
+    def memory_sets(self, sets, where):
+        """{slot index: expression} of an ``initial`` entry's memory values."""
+        names = [m.name for m in self.memory]
+        out = {}
+        for k, v in (sets or {}).items():
+            if k not in names:
+                raise self.bad(f"{where}: {k!r} is not a memory slot"
+                               + (f" (memory: {', '.join(names)})" if names else
+                                  " (the model declares no memory=)"))
+            out[names.index(k)] = self.parse(v, f"{where}, {k}")
         return out
 
     def linear_general(self, f):
@@ -586,7 +655,7 @@ class _Context:
 
 
 def _source(sp, ctx, states, pnames, mode_names, own, fields, rows, branches, init,
-            linear, admissible=None) -> str:
+            linear, admissible=None, cm=()) -> str:
     """The Python source of the seven model functions, and of ``admissible(u, p)`` (plain
     Python) where the method has that condition."""
     from sympy.printing.precedence import PRECEDENCE
@@ -595,6 +664,7 @@ def _source(sp, ctx, states, pnames, mode_names, own, fields, rows, branches, in
     n = len(states)
     names = {ctx.sym[k]: sp.Symbol(f"_x{i}") for i, k in enumerate(states)}
     names.update({ctx.sym[k]: sp.Symbol(f"_p{i}") for i, k in enumerate(pnames)})
+    names.update({m: sp.Symbol(f"_m{j}") for j, m in enumerate(ctx.memory)})
     names.update({ctx.t: sp.Symbol("t"), ctx.C: sp.Symbol("c"), ctx.S: sp.Symbol("s")})
     class Printer(PythonCodePrinter):
         def _print_logistic(self, e):
@@ -636,6 +706,7 @@ def _source(sp, ctx, states, pnames, mode_names, own, fields, rows, branches, in
 
     unpack_p = [f"    _p{i} = p[{i}]" for i in range(len(pnames))]
     unpack_u = [f"    _x{i} = u[{i}]" for i in range(n)]
+    unpack_m = [f"    _m{j} = mem[{j}]" for j in range(len(ctx.memory))]
     # t: the time within the forcing period, 0 <= t < T, whatever the section phase (the
     # kernel's periods run from t_s = phase / omega, so t < t_s + T < 2 T)
     # (a model without forcing: the slot its packed parameters append, its time unit's 1)
@@ -647,7 +718,8 @@ def _source(sp, ctx, states, pnames, mode_names, own, fields, rows, branches, in
         iw = pnames.index(ctx.omega.name) if ctx.omega is not None else len(pnames)
         omega_of_p = f"p[{iw}]"
         T_of_p = f"2.0 * math.pi / {omega_of_p}"
-    exprs = [e for f in fields.values() for e in f] + [c for c, _ in init] + [
+    exprs = [e for f in fields.values() for e in f] + [
+        e for c, _, sets in init for e in (c, *sets.values())] + list(ctx.memory_start) + [
         e for brs in branches.values() for br in brs for c, _, rs in br
         for e in (c, *rs.values())] + [
         r for rs in rows.values() for r in rs if not isinstance(r, list)]
@@ -675,14 +747,17 @@ def _source(sp, ctx, states, pnames, mode_names, own, fields, rows, branches, in
 
     src = ["# generated by nonsmooth.models.equations: do not edit", "import math", "",
            "import numba", _HELPERS]
-    src += ["def field(mode, t, c, s, u, p, mem, du):", *wrap_t, *unpack_u, *unpack_p]
+    src += ["def field(mode, t, c, s, u, p, mem, du):", *wrap_t, *unpack_u, *unpack_p,
+            *unpack_m]
     src += by_mode(lambda m: cse_lines(fields[m], [f"du[{i}]" for i in range(n)])
                    + ["return 0"])
     src += ["", "", "def jacobian(mode, t, c, s, u, p, mem, J):", *wrap_t, *unpack_u,
-            *unpack_p]
+            *unpack_p, *unpack_m]
     X = [ctx.sym[k] for k in states]
-    src += by_mode(lambda m: cse_lines([sp.diff(f, x) for f in fields[m] for x in X],
-                                       [f"J[{i}, {j}]" for i in range(n) for j in range(n)])
+    # the columns of the state, then those of the continuous memory slots (n + slot)
+    cols = [(j, x) for j, x in enumerate(X)] + [(n + q, ctx.memory[q]) for q in cm]
+    src += by_mode(lambda m: cse_lines([sp.diff(f, x) for f in fields[m] for _, x in cols],
+                                       [f"J[{i}, {j}]" for i in range(n) for j, _ in cols])
                    + ["return 0"])
 
     def guard_body(m):
@@ -696,7 +771,7 @@ def _source(sp, ctx, states, pnames, mode_names, own, fields, rows, branches, in
                 out += [f"G[{k}, {n}] = math.nan"]
         return out + [f"return {len(rows.get(m, ()))}"] if out else []
 
-    src += ["", "", "def guards(mode, p, mem, G):", *unpack_p]
+    src += ["", "", "def guards(mode, p, mem, G):", *unpack_p, *unpack_m]
     src += by_mode(guard_body)
 
     def curved_body(m):
@@ -715,7 +790,7 @@ def _source(sp, ctx, states, pnames, mode_names, own, fields, rows, branches, in
         return out + ["return math.nan"] if out else []
 
     src += ["", "", "def curved(mode, k, t, c, s, u, p, mem, grad):", *wrap_t, *unpack_u,
-            *unpack_p]
+            *unpack_p, *unpack_m]
     src += by_mode(curved_body, default="return math.nan")
 
     def transition_body(m):
@@ -725,16 +800,22 @@ def _source(sp, ctx, states, pnames, mode_names, own, fields, rows, branches, in
             for cond, new, reset in brs:
                 out.append(f"    if {code(cond)}:")
                 tmp = [f"        _r{i} = float({code(e)})" for i, e in reset.items()]
-                out += tmp + [f"        u[{i}] = _r{i}" for i in reset] + [f"        return {new}"]
+                out += tmp + [f"        u[{i}] = _r{i}" if i < n else f"        mem[{i - n}] = _r{i}"
+                              for i in reset] + [f"        return {new}"]
         return out + ["return mode"] if out else []
 
     src += ["", "", "def transition(mode, k, t, c, s, u, p, mem):", *wrap_t, *unpack_u,
-            *unpack_p]
+            *unpack_p, *unpack_m]
     src += by_mode(transition_body, default="return mode")
 
     src += ["", "", "def initial(c, s, u, p, mem):",
             f"    t = (math.atan2(s, c) % (2.0 * math.pi)) / {omega_of_p}", *unpack_u, *unpack_p]
-    src += [f"    if {code(cond)}:\n        return {m}" for cond, m in init]
+    # a fresh start: every memory slot at its start value, then the entries' own values
+    src += [f"    mem[{j}] = float({code(v)})" for j, v in enumerate(ctx.memory_start)]
+    src += unpack_m
+    for cond, m, sets in init:
+        src += [f"    if {code(cond)}:"] + [f"        mem[{j}] = float({code(v)})"
+                                            for j, v in sets.items()] + [f"        return {m}"]
     for m, mname in enumerate(mode_names):
         if mname not in own:
             continue
