@@ -173,6 +173,22 @@ def test_stribeck_stick_slip_cycle_coexists_with_stable_steady_sliding():
     assert (lc.mode.values == M.mode_names.index("stick")).any()
 
 
+
+@pytest.mark.parametrize("dx", [0.05, 0.2, 0.5])
+def test_limit_cycle_does_not_report_a_stable_focus_on_the_section_as_a_cycle(dx):
+    """Steady sliding stable (Stribeck, above the Hopf point) and on the section V = 0: from
+    starts that spiral onto it, the shooting converges onto the equilibrium, whose crossings
+    return to it too, with a return time and a multiplier that depend on where Newton stopped
+    (6.097 against 6.287, 0.779 against 0.794, found by an independent check). That is no
+    cycle: the status says so, nothing is reported converged."""
+    p = M.params(v_s=0.5, xi=0.68, v_belt=0.25)
+    eq = ns.equilibria(p)
+    assert int(eq.stable[0]) == 1
+    lc = ns.limit_cycle(p, "V", x0=float(eq.X[0]) + dx, v0=0.0)
+    assert lc.attrs["status"].startswith("equilibrium: ")
+    assert lc.attrs["converged"] == 0 and lc.attrs["verdict"] == "not found"
+    assert math.isnan(float(lc.period)) and int(lc.stable) == 0
+
 def scipy_stick_slip(p, x0, v0, t_end=1000.0, window=200.0):
     """An independent event-driven solution of the unforced belt oscillator (Stribeck slip by
     scipy DOP853, each slip direction's field continued through v_rel = 0, which is located as

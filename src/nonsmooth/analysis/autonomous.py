@@ -272,6 +272,10 @@ def surface_section(params, section="V", *, crossings: int = 200, transient: int
     )
 
 
+#: |f| <= EQUILIBRIUM_TOL (1 + |u|) at a section point: an equilibrium, not a cycle
+EQUILIBRIUM_TOL = 1e-6
+
+
 def _repetition(flow, s, U, Tc):
     """(q, cycle period, at rest) of recorded crossings U at times Tc, the state ``s`` after
     the last: the smallest q <= 16 with U repeating after q crossings to 1e-6 (1 + ‖U‖) (0:
@@ -280,7 +284,7 @@ def _repetition(flow, s, U, Tc):
     crossings = len(U)
     q_found, period = 0, math.nan
     scale = 1.0 + float(np.max(np.abs(U)))
-    at_rest = float(np.linalg.norm(flow.field(s))) <= 1e-6 * scale
+    at_rest = float(np.linalg.norm(flow.field(s))) <= EQUILIBRIUM_TOL * scale
     for q in range(1, 0 if at_rest else min(16, crossings // 2) + 1):
         if np.max(np.abs(U[q:] - U[:-q])) <= 1e-6 * scale:
             q_found, period = q, float(np.mean([Tc[i + q] - Tc[i]
@@ -402,9 +406,12 @@ def limit_cycle(params, section="V", *, x0: float = 0.0, v0: float = 0.0, u0=Non
     and the cycle sampled at ``samples`` points (``X``, ``V``, ... and ``mode`` over ``t``);
     attrs
     ``status`` ("converged", "max_iter", "diverged", "singular", "no crossing: ...",
-    "integration failed: ...", "grazing the section ...", "not confirmed: ..."), ``iterations``,
+    "integration failed: ...", "grazing the section ...", "not confirmed: ...",
+    "equilibrium: ..."), ``iterations``,
     ``residual``. A converged cycle is integrated once more without tangents and must close on
-    itself to ``CONFIRM_TOL``."""
+    itself to ``CONFIRM_TOL``; a point where the field vanishes (to ``EQUILIBRIUM_TOL``: the
+    shooting converged onto an equilibrium that lies on the section, e.g. a stable focus) is
+    no cycle: status "equilibrium: ...", not converged."""
     from ..simulate import check_float, check_int, start_attrs
     from .stability import _section_state, damped_step
     params, solver, flow, text = _setup(params, section, method, rtol, atol, max_time,
@@ -461,6 +468,12 @@ def limit_cycle(params, section="V", *, x0: float = 0.0, v0: float = 0.0, u0=Non
     mu = mu[np.argsort(-np.abs(mu), kind="stable")]
     converged = status == "converged"
     z = state_u(params.model, s)
+    if converged and float(np.linalg.norm(flow.field(s))) <= EQUILIBRIUM_TOL * (
+            1.0 + float(np.linalg.norm(z))):
+        # a focus on the section: its crossings return to it too (to any tolerance), with a
+        # return time and a multiplier that depend on where Newton stopped: no cycle
+        status, converged = ("equilibrium: the shooting converged onto an equilibrium on the "
+                             "section (the field vanishes there): no cycle"), False
     # the cycle itself, sampled, and the confirmation without tangents
     U = np.full((samples, n), np.nan)
     R = np.full(samples, -1, np.int8)
