@@ -8,11 +8,13 @@ defaults (lambda1 on) against the same analysis with ``lyapunov=False``, in the 
 
 Usage::
 
-    python benchmarks/bench_evidence.py [--repeat 2] [--cases poincare]
+    python benchmarks/bench_evidence.py [--repeat 2] [--cases poincare] [--methods smooth]
 
 Prints a table (seconds with and without lambda1, their ratio) and, last, the total seconds
 with lambda1 (for ``../shared/tools/side-by-side``). ``--cases`` keeps the cases whose name
-contains one of the given words (comma-separated).
+contains one of the given words (comma-separated); ``--methods`` the support model's methods
+measured (default ``smooth,exact``; ``smooth_closed_form`` is the switch model solved
+exactly).
 """
 
 from __future__ import annotations
@@ -46,19 +48,20 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--repeat", type=int, default=2)
     ap.add_argument("--cases", default="", help="comma-separated words: only the cases named so")
+    ap.add_argument("--methods", default="smooth,exact", help="comma-separated methods")
     args = ap.parse_args()
     words = [w for w in args.cases.split(",") if w]
     total = 0.0
-    print(f"{'analysis':28s} {'method':7s} {'lambda1 on':>11s} {'off':>8s} {'ratio':>6s}")
+    print(f"{'analysis':28s} {'method':18s} {'lambda1 on':>11s} {'off':>8s} {'ratio':>6s}")
     for name, f in CASES.items():
         if words and not any(w in name for w in words):
             continue
-        for method in ("smooth", "exact"):
+        for method in args.methods.split(","):
             f(method, True)  # warm-up: compile / load
             on = best(lambda: f(method, True), args.repeat)
             off = best(lambda: f(method, False), args.repeat)
             total += on
-            print(f"{name:28s} {method:7s} {on:10.2f}s {off:7.2f}s {on / off:6.2f}")
+            print(f"{name:28s} {method:18s} {on:10.2f}s {off:7.2f}s {on / off:6.2f}")
     print(f"{total:.3f}")
 
 

@@ -314,7 +314,8 @@ def test_the_page_loads_and_shows_the_orbit(page):
     assert page.prop("param_omega", "value") == "0.91"
     assert len(page.data("section_source", "a")) == compute.VIEW_RECORD
     assert len(page.data("time_source", "t")) > 100
-    assert sorted(page.prop("method", "options")) == ["exact", "smooth", "smooth_eq12"]
+    assert sorted(page.prop("method", "options")) == ["exact", "smooth", "smooth_closed_form",
+                                                      "smooth_eq12"]
     assert "Γ" in page.prop("modes", "text") or "Gamma" in page.prop("modes", "text")
     eta = float(page.prop("param_eta", "value"))  # a log slider: eta spans decades
     assert page.prop("slider_eta", "value") == pytest.approx(math.log10(eta))

@@ -51,7 +51,8 @@ def test_models_lists_the_builtins_and_model_returns_them():
     for name in BUILTIN:
         m = ns.model(name)
         assert m.name == name and m.description and m.parameters
-        assert set(m.methods) == ({"smooth", "smooth_eq12", "exact"} if name == "support"
+        assert set(m.methods) == ({"smooth", "smooth_eq12", "smooth_closed_form", "exact"}
+                                  if name == "support"
                                   else {"smooth", "exact"})
         assert m.omega in m.param_names
         assert m.summary()["name"] == name

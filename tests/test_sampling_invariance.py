@@ -25,7 +25,7 @@ STRIBECK = dict(omega0=0.7, xi=0.02, v_belt=0.5, mu_s=0.9, mu_k=0.2, v_s=0.8, F0
 #: located stick/slip events at rtol 1e-12)
 STRIBECK_X10 = 0.7024897576
 
-TOL = {"exact": 1e-8, "smooth": 2e-5, "smooth_eq12": 2e-5}
+TOL = {"exact": 1e-8, "smooth": 2e-5, "smooth_eq12": 2e-5, "smooth_closed_form": 1e-8}
 
 
 def _sections(params, method, spp, periods, x0=0.0, v0=0.0):
@@ -39,6 +39,8 @@ def _cases():
     yield "support", ns.preset("table3").replace(omega=0.92), ("smooth", "exact"), 30
     yield "support fig7", ns.preset("fig7"), ("smooth", "exact"), 30
     yield "support eq12", ns.preset("table3").replace(omega=0.92), ("smooth_eq12",), 30
+    yield "support closed form", ns.preset("table3").replace(omega=0.92), (
+        "smooth_closed_form",), 30
     ball = ns.model("bouncing_ball")
     yield "bouncing_ball", ball.preset("period_one"), ("smooth", "exact"), 30  # with sticking
     yield "bouncing_ball chaotic", ball.preset("chaotic"), ("smooth", "exact"), 4  # Gamma = 3

@@ -31,7 +31,8 @@ MethodOpt = Annotated[Optional[str], typer.Option(
     "--method", show_default=False,
     help="smooth (switch model, RKF45) or exact (eta = 0; event-driven: --set eta=... is "
          "accepted and ignored, the exact model has no band), or another method of the model "
-         "(support: smooth_eq12, the convex transition fields of eq. 12); default: smooth, or "
+         "(support: smooth_eq12, the convex transition fields of eq. 12; smooth_closed_form, "
+         "eq. 13 solved exactly); default: smooth, or "
          "the model's first method if it has no smooth one")]
 RtolOpt = Annotated[float, typer.Option("--rtol", help="relative tolerance")]
 AtolOpt = Annotated[float, typer.Option("--atol", help="absolute tolerance")]

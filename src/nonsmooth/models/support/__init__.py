@@ -7,13 +7,18 @@ omega_s^2 (X - 1) + xi_s X'. Methods:
 * ``smooth``: the paper's switch model with bands of half-width eta (regions Gamma-,
   Sigma_alpha, Sigma_beta, Gamma+ of eq. 14; transition fields eq. 13);
 * ``smooth_eq12``: the same regions with the convex transition fields of eq. 12;
+* ``smooth_closed_form``: the switch model of ``smooth`` solved exactly, on the generic
+  kernel: Gamma-, Sigma_beta and Gamma+ are linear oscillators, propagated in closed form,
+  and Sigma_alpha (whose field uses the memory Va) by RKF45 at rtol 1e-12, so the solution is
+  that of the equations to about 1e-12, where ``smooth`` carries the RKF45's error at the
+  paper's tolerances (1e-8);
 * ``exact``: the non-smooth system (eta = 0), event-driven in closed form.
 
-All three run on specialised kernels with these functions inlined (``smooth_kernel``,
-``exact_kernel``); the generic descriptions in :mod:`.generic` describe the same model through
-the interface of :mod:`nonsmooth.models.base` (used by the generic kernel for tangent
-dynamics, and tested against the specialised kernels). Its parameters and the paper's sets
-are in :mod:`.parameters`.
+``smooth``, ``smooth_eq12`` and ``exact`` run on specialised kernels with these functions
+inlined (``smooth_kernel``, ``exact_kernel``); the generic descriptions in :mod:`.generic`
+describe the same model through the interface of :mod:`nonsmooth.models.base` (used by the
+generic kernel for tangent dynamics and for ``smooth_closed_form``, and tested against the
+specialised kernels). Its parameters and the paper's sets are in :mod:`.parameters`.
 """
 
 from __future__ import annotations
@@ -60,6 +65,13 @@ MODEL = Model(
                               variant=TRANSITION_EQ12,
                               description="switch model with the convex transition fields of "
                                           "eq. 12 instead of eq. 13 (RKF45, located switches)"),
+        "smooth_closed_form": Method(
+            g.smooth_field, g.smooth_jacobian, g.smooth_guards, g.smooth_transition,
+            g.smooth_initial, g.smooth_linear, closed_form=True, modes=(0, 1, 2, 3),
+            flow_is_homeomorphism=True, continuous_memory=(0,), rtol=1e-12, atol=1e-14,
+            description="switch model, eqs. 10-14, solved exactly: closed form in Gamma-, "
+                        "Sigma_beta and Gamma+, RKF45 at rtol 1e-12 in Sigma_alpha (whose "
+                        "field uses the entry velocity Va)"),
         "exact": Method(g.exact_field, g.exact_jacobian, g.exact_guards, g.exact_transition,
                         g.exact_initial, g.exact_linear, closed_form=True, modes=(0, 3),
                         flow_is_homeomorphism=True, kernel=KERNEL_SUPPORT_EXACT,

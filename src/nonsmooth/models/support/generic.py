@@ -64,6 +64,30 @@ def smooth_jacobian(mode, t, c, s, u, p, mem, J):
     return 0
 
 
+def smooth_linear(mode, p, out):
+    # the oscillator form X'' + c X' + k X = F0 cos(omega t) + b of Gamma- (eq. 11a), Sigma_beta
+    # (eq. 13b) and Gamma+ (eq. 11b), out = (k, c, b, F0): propagated in closed form by the
+    # method smooth_closed_form; Sigma_alpha's field depends on the memory Va (eq. 13a): none
+    if mode == SIGMA_ALPHA:
+        return 0
+    w02 = p[_W0] * p[_W0]
+    ws2 = p[_WS] * p[_WS]
+    if mode == GAMMA_PLUS:
+        out[0] = w02 + ws2
+        out[1] = p[_XI] + p[_XIS]
+        out[2] = ws2
+    elif mode == SIGMA_BETA:
+        out[0] = w02 + 0.5 * ws2
+        out[1] = p[_XI] + 0.5 * p[_XIS]
+        out[2] = 0.5 * ws2 * (1.0 - p[_ETA])
+    else:
+        out[0] = w02
+        out[1] = p[_XI]
+        out[2] = 0.0
+    out[3] = p[_F0]
+    return 1
+
+
 def smooth_eq12_field(mode, t, c, s, u, p, mem, du):
     # the convex combinations of eq. 12: (1 - q) f_- + q f_+ in Sigma_alpha (12a), (1 - q) f_+
     # + q f_- in Sigma_beta (12b); no memory
