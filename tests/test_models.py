@@ -52,8 +52,9 @@ def test_models_lists_the_builtins_and_model_returns_them():
         m = ns.model(name)
         assert m.name == name and m.description and m.parameters
         assert set(m.methods) == ({"smooth", "smooth_eq12", "smooth_closed_form", "exact"}
-                                  if name == "support"
-                                  else {"smooth", "exact"})
+                                  if name == "support" else
+                                  {"smooth", "smooth_closed_form", "exact"}
+                                  if name == "two_sided" else {"smooth", "exact"})
         assert m.omega in m.param_names
         assert m.summary()["name"] == name
         for p in m.parameters:  # every parameter has a range text and units

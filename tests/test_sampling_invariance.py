@@ -45,6 +45,8 @@ def _cases():
     yield "bouncing_ball", ball.preset("period_one"), ("smooth", "exact"), 30  # with sticking
     yield "bouncing_ball chaotic", ball.preset("chaotic"), ("smooth", "exact"), 4  # Gamma = 3
     yield "two_sided", ns.model("two_sided").params(), ("smooth", "exact"), 8  # chaotic
+    yield "two_sided closed form", ns.model("two_sided").params(F0=0.6, omega=1.3), (
+        "smooth_closed_form",), 20  # period 1, both supports
     yield "impact", ns.model("impact").params(), ("smooth", "exact"), 30
     ss = ns.model("stick_slip")
     yield "stick_slip", ss.params(), ("smooth", "exact"), 30

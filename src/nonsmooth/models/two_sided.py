@@ -17,6 +17,10 @@ right side), 4-6 the same on the left. Memory: mem[0] = entry velocity V into Si
 region is the intersection of the two sides' Gamma- (each a union: one row per side, selected
 by its memory slot). The bands of the two sides never overlap (gap_r + gap_l > 2 eta).
 
+``method="smooth_closed_form"``: the same equations solved exactly (as the support model's
+method of that name): free flight, Sigma_beta and contact in closed form, Sigma_alpha by RKF45
+at rtol 1e-12.
+
 ``method="exact"``: event-driven (eta = 0), modes free / contact_r / contact_l, closed form
 between events. Contact starts when X reaches a gap moving outwards (a grazing touch, V = 0,
 is no contact), ends when the support force vanishes; after a separation beyond the gap the
@@ -145,6 +149,32 @@ def smooth_field(mode, t, c, s, u, p, mem, du):
     du[0] = V
     du[1] = a
     return 0
+
+
+def smooth_linear(mode, p, out):
+    # the oscillator form X'' + c X' + k X = F0 cos(omega t) + b of free flight and of either
+    # side's Sigma_beta and contact (eqs. 11a, 13b, 11b in the side's coordinate Y = sigma X),
+    # out = (k, c, b, F0): the method smooth_closed_form; a Sigma_alpha's field uses the side's
+    # entry velocity (eq. 13a): none
+    w02 = p[_W0] * p[_W0]
+    out[0] = w02
+    out[1] = p[_XI]
+    out[2] = 0.0
+    if mode != FREE:
+        side, lr = _split(mode)
+        if lr == _SA:
+            return 0
+        sg, g, w2, x, r = _side(p, side)
+        if lr == _GP:
+            out[0] = w02 + w2
+            out[1] = p[_XI] + x
+            out[2] = sg * w2 * g
+        else:
+            out[0] = w02 + 0.5 * w2
+            out[1] = p[_XI] + 0.5 * x
+            out[2] = sg * 0.5 * w2 * (g - p[_ETA])
+    out[3] = p[_F0]
+    return 1
 
 
 def smooth_jacobian(mode, t, c, s, u, p, mem, J):
@@ -403,7 +433,7 @@ def _contact(params, mask, max_X, min_X):
 def _lines(params, method):
     lines = [(params.gap_r, "right support (X = gap_r)"),
              (-params.gap_l, "left support (X = -gap_l)")]
-    if method == "smooth":
+    if method != "exact":
         e = params.eta
         lines += [(params.gap_r - e, "band edge"), (params.gap_r + e, "band edge"),
                   (-params.gap_l - e, "band edge"), (-params.gap_l + e, "band edge")]
@@ -428,6 +458,14 @@ MODEL = Model(
                          flow_is_homeomorphism=True, continuous_memory=(_VA_R, _VA_L),
                          description="switch model (eq. 13) at each support, RKF45 with "
                                      "located switches"),
+        "smooth_closed_form": Method(
+            smooth_field, smooth_jacobian, smooth_guards, smooth_transition, smooth_initial,
+            smooth_linear, closed_form=True, modes=(0, 1, 2, 3, 4, 5, 6),
+            flow_is_homeomorphism=True, continuous_memory=(_VA_R, _VA_L), rtol=1e-12,
+            atol=1e-14,
+            description="the switch model of smooth solved exactly: free flight, Sigma_beta and "
+                        "contact in closed form, Sigma_alpha (its field uses the entry "
+                        "velocity) by RKF45 at rtol 1e-12"),
         "exact": Method(exact_field, exact_jacobian, exact_guards, exact_transition,
                         exact_initial, exact_linear, closed_form=True, modes=(0, 3, 6),
                         flow_is_homeomorphism=True,

@@ -1,8 +1,8 @@
-"""The support model's ``smooth_closed_form`` method: the switch model (eq. 13) solved exactly,
-Gamma-, Sigma_beta and Gamma+ in closed form and Sigma_alpha by RKF45 at rtol 1e-12. Its
-oracle is the same equations integrated by the RKF45 alone at rtol 1e-12 (``smooth`` on the
-generic kernel), from which it must differ by that integrator's error only, while ``smooth``
-at the paper's tolerances differs by about 1e-6."""
+"""The ``smooth_closed_form`` method of the support and two_sided models: the switch model
+(eq. 13) solved exactly, Gamma-, Sigma_beta and Gamma+ in closed form and Sigma_alpha by RKF45
+at rtol 1e-12. Its oracle is the same equations integrated by the RKF45 alone at rtol 1e-12
+(``smooth`` on the generic kernel), from which it must differ by that integrator's error
+only, while ``smooth`` at the paper's tolerances differs by about 1e-6."""
 
 import numpy as np
 import pytest
@@ -17,7 +17,7 @@ SUPPORT = ns.model("support")
 
 
 def _sections(p, method, periods, rtol=1e-8, atol=1e-10):
-    s = Solver(model=SUPPORT, method=method, rtol=rtol, atol=atol)
+    s = Solver(model=p.model, method=method, rtol=rtol, atol=atol)
     buf = output_buffers(periods)
     code = KERNEL_GENERIC if method == "smooth" else s.code
     assert run(code, s.fns, p.pack(), s.opts(), new_state(0.0, 0.0), 1, 0, periods, *buf) \
@@ -66,3 +66,18 @@ def test_chaotic_lambda1_agrees_with_the_paper_tolerance_method():
     se = float(np.hypot(a.stderr[0], b.stderr[0]))
     assert la > 10 * float(a.stderr[0])  # chaotic
     assert abs(la - lb) < 4 * se, (la, lb, se)
+
+
+def test_two_sided_closed_form_against_the_tight_rkf45():
+    """Both supports hit every period (F0 = 0.6, omega = 1.3: period 1): each side's Sigma_alpha
+    with its own entry velocity, the other regions in closed form."""
+    p = ns.model("two_sided").params(F0=0.6, omega=1.3)
+    cf = _sections(p, "smooth_closed_form", 40)
+    tight = _sections(p, "smooth", 40, rtol=1e-12, atol=1e-14)
+    paper = _sections(p, "smooth", 40)
+    err = np.max(np.abs(cf[0] - tight[0]) + np.abs(cf[1] - tight[1]))
+    rkf = np.max(np.abs(paper[0] - tight[0]) + np.abs(paper[1] - tight[1]))
+    assert err < 1e-9 and rkf > 100 * err, (err, rkf)
+    np.testing.assert_array_equal(cf[3], tight[3])
+    assert np.count_nonzero(cf[3] & 0b0000010) > 25  # Sigma_alpha_r (its Va)
+    assert np.count_nonzero(cf[3] & 0b0010000) > 25  # Sigma_alpha_l (its Va)
