@@ -16,6 +16,9 @@ Gamma+), the support force of eq. 13 in the bands, and two memory slots:
     nonsmooth poincare --model examples/switch_model_equations.py:MODEL --preset table3 \\
         --method smooth
 
+It is written for omega_s > 0 (h_beta divides by omega_s^2; the built-in model also takes
+omega_s = xi_s = 0, a support that is not there).
+
 ``closed_form=False`` keeps every region on the RKF45, as the built-in model: Gamma-,
 Sigma_beta and Gamma+ are linear and would otherwise be propagated in closed form (Sigma_alpha
 uses the memory Va, so it has none), which solves the smoothed equations more exactly than

@@ -173,7 +173,6 @@ def test_stribeck_stick_slip_cycle_coexists_with_stable_steady_sliding():
     assert (lc.mode.values == M.mode_names.index("stick")).any()
 
 
-
 @pytest.mark.parametrize("dx", [0.05, 0.2, 0.5])
 def test_limit_cycle_does_not_report_a_stable_focus_on_the_section_as_a_cycle(dx):
     """Steady sliding stable (Stribeck, above the Hopf point) and on the section V = 0: from

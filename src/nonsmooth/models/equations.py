@@ -127,10 +127,11 @@ def model_from_equations(name: str, *, states, parameters, modes: dict | None = 
     start): values the trajectory carries from event to event (an entry velocity, which side
     of a union region holds). Expressions may use them; a reset may set them
     (``reset={"Va": "V"}``), and so may an ``initial`` entry ``(condition, mode, {"Va":
-    "V"})``. A slot that some mode's field depends on is continuous memory (the tangent
-    dynamics carry it; its Jacobian column is derived); a surface may depend on the other
-    slots only (flags: the tangent cannot follow a surface that moves with a continuous
-    slot), and a mode whose field uses a slot has no closed form. Other keywords
+    "V"})``. A slot that some mode's field varies with, or that takes values varying with the
+    state and is read by a reset, is continuous memory (the tangent dynamics carry it; its
+    Jacobian column is derived); a surface may vary only with flags (slots set to constants:
+    the tangent cannot follow a surface that moves with the state's memory), and a mode whose
+    field uses a slot has no closed form. Other keywords
     (``state_units``, ``state_long_names``, ``presets``, ``contact_name``, ``lines``,
     ``references``, ``check``, ...) go to :class:`Model` as they are.
 
@@ -205,6 +206,10 @@ def model_from_equations(name: str, *, states, parameters, modes: dict | None = 
         ctx.period = period
         ctx.memory = [sym[m] for m in mnames]
         ctx.memory_start = [ctx.parse(v, f"memory {m}") for m, v in memory.items()]
+        for m, v in zip(mnames, ctx.memory_start):
+            if v.free_symbols & set(ctx.memory):
+                raise bad(f"memory {m}: a start value is an expression of the state, the "
+                          f"parameters and t, not of memory")
         derived = {mname: _derive(sp, ctx, name, mname, spec, states, pnames, mode_names,
                                   closed_form, bad) for mname, spec in methods.items()}
     built = {mname: _method(name, mname, entry, pnames) for mname, entry in derived.items()}
@@ -313,11 +318,7 @@ def _derive(sp, ctx, name, mname, spec, states, pnames, mode_names, closed_form,
             raise bad(f"mode {mode}: {len(exprs)} expressions for {n} states")
         fields[mode] = [ctx.parse(e, f"mode {mode}, d{states[i]}/dt")
                         for i, e in enumerate(exprs)]
-    # continuous memory: the slots some field of this method depends on (the tangent carries
-    # them); the others are flags
-    cm = [j for j, m in enumerate(ctx.memory)
-          if any(f.has(m) for fs in fields.values() for f in fs)]
-    rows, branches = {}, {}
+    rows, branches, surfaces = {}, {}, []
     for mode, glist in (spec.get("guards") or {}).items():
         if mode not in own:
             raise bad(f"guards: unknown mode {mode!r} (modes: {', '.join(own)})")
@@ -326,12 +327,7 @@ def _derive(sp, ctx, name, mname, spec, states, pnames, mode_names, closed_form,
             g = g if isinstance(g, Guard) else Guard(*g)
             where = f"mode {mode}, surface {j}"
             surface = ctx.parse(g.surface, where)
-            moving = [ctx.memory[q].name for q in cm if surface.has(ctx.memory[q])]
-            if moving:
-                raise bad(f"{where}: the surface depends on the memory slot {moving[0]!r}, "
-                          f"which a field depends on too (continuous memory): the tangent "
-                          f"dynamics cannot follow a surface that moves with it (a surface may "
-                          f"use flags, memory no field uses)")
+            surfaces.append((where, surface))
             rows[mode].append(ctx.surface(surface, where))
             branches[mode].append(ctx.branches(g, where, own, mode_names))
     init = []
@@ -343,6 +339,7 @@ def _derive(sp, ctx, name, mname, spec, states, pnames, mode_names, closed_form,
         sets = ctx.memory_sets(entry[2] if len(entry) == 3 else None, f"initial, entry {i}")
         init.append((ctx.condition(entry[0], f"initial, condition {i}"),
                      mode_names.index(entry[1]), sets))
+    cm = _continuous_memory(sp, ctx, fields, branches, init, surfaces, n, bad)
     # the closed form of linear modes: the oscillator's (n = 2, k > 0) where it applies, else
     # the general form (any n, any stiffness: ``integrate.linmodes``); a field that uses
     # memory has none (``linear`` sees the parameters only)
@@ -373,12 +370,61 @@ def _derive(sp, ctx, name, mname, spec, states, pnames, mode_names, closed_form,
             "admissible": None if text is None else str(text)}
 
 
+def _depends(sp, e, x) -> bool:
+    """Whether expression e varies with the symbol x (a nonzero derivative: a Piecewise whose
+    conditions alone use x does not)."""
+    if not e.has(x):
+        return False
+    d = sp.diff(e, x)
+    return not (d == 0 or sp.simplify(d) == 0)
+
+
+def _continuous_memory(sp, ctx, fields, branches, init, surfaces, n, bad) -> list:
+    """The memory slots the tangent dynamics must carry (``Method.continuous_memory``): those
+    a field varies with, and those that take a value varying with the state (a reset or an
+    initial value, through other such slots too) and that a reset reads (the saltation
+    differentiates the transition). The other slots are flags (piecewise constant in the
+    state). A surface may not vary with a slot that varies with the state: the saltation's
+    time shift uses the surface's gradient in the state only."""
+    mem = ctx.memory
+    states = ctx.states
+    resets = [(i, e) for brs in branches.values() for br in brs for _, _, rs in br
+              for i, e in rs.items()]
+    sets = [(n + j, e) for _, _, st in init for j, e in st.items()] + [
+        (n + j, e) for j, e in enumerate(ctx.memory_start)]
+    varying = set()  # slots whose values vary with the state
+    changed = True
+    while changed:
+        changed = False
+        for i, e in resets + sets:
+            j = i - n
+            if j >= 0 and j not in varying and any(
+                    _depends(sp, e, x) for x in states + [mem[q] for q in varying]):
+                varying.add(j)
+                changed = True
+    read = {j for j, m in enumerate(mem) if any(_depends(sp, e, m) for _, e in resets)}
+    cm = sorted({j for j, m in enumerate(mem)
+                 if any(_depends(sp, f, m) for fs in fields.values() for f in fs)}
+                | (varying & read))
+    for where, g in surfaces:
+        moving = [mem[q].name for q in sorted(varying | set(cm)) if _depends(sp, g, mem[q])]
+        if moving:
+            raise bad(f"{where}: the surface varies with the memory slot {moving[0]!r}, which "
+                      f"the tangent dynamics carry (a field varies with it, or it takes values "
+                      f"that vary with the state): they cannot follow a surface that moves "
+                      f"with it; a surface may use flags (slots set to constants that no "
+                      f"field uses)")
+    return cm
+
+
 def _admissible(ctx, text, bad):
     """``admissible=`` of a method: a condition on the state and the parameters (no t) that
     every start must meet (the generated ``admissible(u, p)`` evaluates it)."""
     cond = ctx.condition(text, "admissible")
-    if ctx.t in cond.free_symbols or ctx.C in cond.free_symbols or ctx.S in cond.free_symbols:
-        raise bad("admissible: a condition on the state and the parameters, without t")
+    if ctx.t in cond.free_symbols or ctx.C in cond.free_symbols or ctx.S in cond.free_symbols \
+            or cond.free_symbols & set(ctx.memory):
+        raise bad("admissible: a condition on the state and the parameters, without t or "
+                  "memory")
     return cond
 
 
@@ -440,13 +486,13 @@ def _memory(memory, bad) -> dict:
         return {}
     if isinstance(memory, str):
         memory = (memory,)
-    if isinstance(memory, dict):
-        return dict(memory)
     try:
-        return {m: 0 for m in memory}
+        out = dict(memory) if isinstance(memory, dict) else {m: 0 for m in memory}
     except TypeError:
-        raise bad("memory: a dict {name: value at a fresh start} or a sequence of names") \
-            from None
+        out = None
+    if out is None or not all(isinstance(m, str) for m in out):
+        raise bad("memory: a dict {name: value at a fresh start} or a sequence of names")
+    return out
 
 
 def _mode_index(m, mode_names, bad) -> int:

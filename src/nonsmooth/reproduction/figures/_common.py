@@ -27,6 +27,8 @@ def method_text(ds) -> str:
     parts = [m]
     if m in ("smooth", "smooth_eq12"):
         parts.append(f"switch model ({'eq12' if m == 'smooth_eq12' else 'eq13'}), RKF45")
+    elif m == "smooth_closed_form":
+        parts.append("switch model (eq13) solved exactly: closed form, RKF45 in Sigma_alpha")
     else:
         parts.append("exact non-smooth, closed form between events")
     if "rtol" in a:
