@@ -64,28 +64,28 @@ def smooth_jacobian(mode, t, c, s, u, p, mem, J):
     return 0
 
 
+@nb.njit(cache=True)
+def _oscillator_row(p, share, b, out):
+    """``linear``'s oscillator row (k, c, b, F0) of X'' + c X' + k X = F0 cos(omega t) + b with
+    the ``share`` (0, 1/2 or 1) of the support's stiffness and damping."""
+    out[0] = p[_W0] * p[_W0] + share * (p[_WS] * p[_WS])
+    out[1] = p[_XI] + share * p[_XIS]
+    out[2] = b
+    out[3] = p[_F0]
+    return 1
+
+
 def smooth_linear(mode, p, out):
-    # the oscillator form X'' + c X' + k X = F0 cos(omega t) + b of Gamma- (eq. 11a), Sigma_beta
-    # (eq. 13b) and Gamma+ (eq. 11b), out = (k, c, b, F0): propagated in closed form by the
+    # the oscillator form of Gamma- (eq. 11a), Sigma_beta (eq. 13b) and Gamma+ (eq. 11b): the
     # method smooth_closed_form; Sigma_alpha's field depends on the memory Va (eq. 13a): none
     if mode == SIGMA_ALPHA:
         return 0
-    w02 = p[_W0] * p[_W0]
     ws2 = p[_WS] * p[_WS]
     if mode == GAMMA_PLUS:
-        out[0] = w02 + ws2
-        out[1] = p[_XI] + p[_XIS]
-        out[2] = ws2
-    elif mode == SIGMA_BETA:
-        out[0] = w02 + 0.5 * ws2
-        out[1] = p[_XI] + 0.5 * p[_XIS]
-        out[2] = 0.5 * ws2 * (1.0 - p[_ETA])
-    else:
-        out[0] = w02
-        out[1] = p[_XI]
-        out[2] = 0.0
-    out[3] = p[_F0]
-    return 1
+        return _oscillator_row(p, 1.0, ws2, out)
+    if mode == SIGMA_BETA:
+        return _oscillator_row(p, 0.5, 0.5 * ws2 * (1.0 - p[_ETA]), out)
+    return _oscillator_row(p, 0.0, 0.0, out)
 
 
 def smooth_eq12_field(mode, t, c, s, u, p, mem, du):
@@ -270,15 +270,6 @@ def exact_initial(c, s, u, p, mem):
 
 
 def exact_linear(mode, p, out):
-    w02 = p[_W0] * p[_W0]
     if mode == _CONTACT:
-        ws2 = p[_WS] * p[_WS]
-        out[0] = w02 + ws2
-        out[1] = p[_XI] + p[_XIS]
-        out[2] = ws2
-    else:
-        out[0] = w02
-        out[1] = p[_XI]
-        out[2] = 0.0
-    out[3] = p[_F0]
-    return 1
+        return _oscillator_row(p, 1.0, p[_WS] * p[_WS], out)
+    return _oscillator_row(p, 0.0, 0.0, out)
