@@ -750,3 +750,44 @@ def test_rk_tangent_is_the_derivative_of_the_rk_step(n):
                                           np.zeros((n + 1, 0)))) / (2 * eps)
     assert np.max(np.abs(Y[:n] - F)) <= 1e-8 * np.max(np.abs(F))
     assert np.array_equal(Y[n], np.eye(n + 1)[n])  # the memory row is constant in a mode
+
+
+def test_rk8_dense_output_is_scipys_dop853_interpolant():
+    """The DOP853 step of the generic kernel (``integrate.rk8``, the plain runs at rtol below
+    1e-10) and its dense output written as a polynomial piece: the step's end and the
+    interpolant at interior points against scipy's own DOP853 step and dense output (the same
+    method: to round-off), the forcing rows against cos and sin."""
+    from scipy.integrate import DOP853
+
+    from nonsmooth.integrate import rk8
+    from nonsmooth.integrate.linmodes import N_TAYLOR
+
+    om, tau, h = 1.3, 0.4 / 1.3, 0.2
+    C, S = math.cos(om * tau), math.sin(om * tau)
+
+    def field(mode, t, c, s, u, p, mem, du):
+        du[0] = u[1]
+        du[1] = -u[0] - 0.3 * u[0] ** 3 + 0.5 * c
+        return 0
+
+    u = np.array([0.3, -0.2])
+    k0, u1, f1, us = np.zeros(2), np.zeros(2), np.zeros(2), np.zeros(2)
+    field(0, tau, C, S, u, None, None, k0)
+    K = np.zeros((16, 2))
+    TW = np.zeros((5, N_TAYLOR + 1))
+    err2, C1, S1 = rk8.rk8_step.py_func(field, 0, tau, C, S, h, om, 2, u, k0, None, None, 1e-6,
+                                        1e-8, us, K, u1, f1)
+    rk8.rk8_dense.py_func(field, 0, tau, C, S, h, om, 2, u, u1, f1, None, None, us, K, TW)
+    ref = DOP853(lambda t, y: np.array([y[1], -y[0] - 0.3 * y[0] ** 3 + 0.5 * math.cos(om * t)]),
+                 tau, u, tau + 10, first_step=h, max_step=h, rtol=1e-3, atol=1e-3)
+    ref.step()
+    assert abs(ref.t - (tau + h)) < 1e-15 and np.abs(ref.y - u1).max() < 1e-15
+    assert abs(C1 - math.cos(om * (tau + h))) < 1e-15 and abs(S1 - math.sin(om * (tau + h))) < 1e-15
+    dense = ref.dense_output()
+    for x in (0.0, 0.3, 0.5, 0.77, 1.0):
+        s = x * h
+        got = np.array([np.polyval(TW[i][::-1], s) for i in range(5)])
+        assert np.abs(got[:2] - dense(tau + s)).max() < 1e-15
+        assert got[2] == 1.0
+        assert abs(got[3] - math.cos(om * (tau + s))) < 1e-15
+        assert abs(got[4] - math.sin(om * (tau + s))) < 1e-15

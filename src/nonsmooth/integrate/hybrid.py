@@ -10,7 +10,11 @@ Design summary
 * A mode's field is integrated with the RKF45 table of :mod:`.tableau` (local extrapolation,
   elementary controller h err^(-1/5) with ``pow_fast``, RMS error norm over the n components,
   output times hit by shortening the last step without disturbing the controller), as in
-  :mod:`.rkf45`; each step holds the field of the current mode fixed.
+  :mod:`.rkf45`; each step holds the field of the current mode fixed. A plain run (no tangent
+  columns) at rtol below ``rk8.HI_ORDER_RTOL`` (the exact methods' nonlinear modes at 1e-12)
+  takes DOP853 steps instead (:mod:`.rk8`): a crossing located on the step's cubic Hermite is
+  then refined by Newton steps on the true guard at the retaken step's end, and an extremum
+  of X by retaken partial steps.
 * Guards are affine in (u, cos, sin): inside a mode every g_k >= 0. After an accepted step the
   exit test is g_k(end) < 0, or a negative value of g_k (on the step's cubic Hermite state
   interpolant, exact forcing) at an interior minimum of the Hermite of (g, g'). The earliest
@@ -101,6 +105,7 @@ from .record import record_interval  # noqa: E402
 from .roots import illinois_point, illinois_update, quad_roots01  # noqa: E402
 from .rkstep import (_A, _B, _C, _E, _FM, _NS, _control, _cubic, _shrink,  # noqa: E402
                      _x_extrema)
+from .rk8 import HI_ORDER_RTOL, control8, rk8_dense, rk8_step, shrink8  # noqa: E402
 from .trig import cos_sin_small  # noqa: E402
 from .workspace import keep_alive, unowned, view  # noqa: E402
 
@@ -807,13 +812,16 @@ def _rotate(C, S, th):
 
 @nb.njit(cache=True)
 def _retake(field, pm, mode, tau, C, S, hs, om, n, u, f0, pp, mem, rtol, atol, us, k1, k2, k3,
-            k4, k5, u1, f1, TW):
-    """The step retaken from (tau, u) to tau + hs, on the RKF45 or on the piece's series
-    (``pm``): u1 and f1 at its end; returns (err2, cos, sin) there."""
+            k4, k5, u1, f1, TW, use8, K8):
+    """The step retaken from (tau, u) to tau + hs, on the RKF45 (the DOP853 with ``use8``) or
+    on the piece's series (``pm``): u1 and f1 at its end; returns (err2, cos, sin) there."""
     err2 = 0.0
     if pm:
         poly_state(TW, n, hs, u1)
         C1, S1 = _rotate(C, S, om * hs)
+    elif use8:
+        return rk8_step(field, mode, tau, C, S, hs, om, n, u, f0, pp, mem, rtol, atol, us, K8,
+                        u1, f1)
     else:
         err2, C1, S1 = _rk_step(field, mode, tau, C, S, hs, om, n, u, f0, pp, mem, rtol, atol,
                                 us, k1, k2, k3, k4, k5, u1)
@@ -1417,7 +1425,7 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
     nj = n + nmem if tan else 0
     nlin = max(4, n * n + 3 * n)  # a ``linear`` row: (k, c, b, F), or (A, b, f_c, f_s)
     m3 = n + 3
-    sizes = (len(p), 10 * n, nme, MAX_GUARDS * (n + 3), MAX_MODES * (N_MC + 7), nlin,
+    sizes = (len(p), 26 * n, nme, MAX_GUARDS * (n + 3), MAX_MODES * (N_MC + 7), nlin,
              N_BD * (1 + MAX_GUARDS), (SCAN_DEPTH + 1) * 5, _NS * nt * mt, 6 * nt + nt * nj,
              _NS * nt * nj if nt == 2 or nt == 4 else 0,
              2 * nme if tan else 0, len(cmi), mt, n + 1,
@@ -1435,6 +1443,8 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
     u, u1, f0, f1, us = rows[0], rows[1], rows[2], rows[3], rows[4]
     k1, k2, k3, k4, k5 = rows[5], rows[6], rows[7], rows[8], rows[9]
     o += 10 * n
+    K8 = view(ws, o, (16, n))  # DOP853: 12 stages, the field at the end, 3 dense stages
+    o += 16 * n
     mem = view(ws, o, (nme,))
     o += nme
     G = view(ws, o, (MAX_GUARDS, n + 3))
@@ -1501,6 +1511,8 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
     rtol = opts[OPT_RTOL]
     atol = opts[OPT_ATOL]
     closed = opts[OPT_CLOSED_FORM] == 1.0
+    # plain runs at a tight tolerance integrate by DOP853 (``rk8``); tangent runs by the RKF45
+    use8 = not tan and rtol < HI_ORDER_RTOL
     om4 = (om * om) * (om * om)
     for q in range(len(cmi)):
         if cmi[q] < 0 or cmi[q] >= nmem:
@@ -1602,6 +1614,7 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
                 y0 = 0.0
                 z0 = 0.0
                 err2 = 0.0
+                pd = False  # a DOP853 step with its dense output in TW
                 if cf:
                     Lm = MC[mode, MC_LMAX]
                     last = Lm >= rem
@@ -1638,16 +1651,28 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
                 else:
                     last = h >= rem * 0.999
                     hs = rem if last else h
-                    err2, C1, S1 = _rk_step(field, mode, tau, C, S, hs, om, n, u, f0, pp, mem,
-                                            rtol, atol, us, k1, k2, k3, k4, k5, u1)
+                    if use8 and om * hs > THETA_POLY:  # (its forcing's series on the piece)
+                        hs = THETA_POLY / om
+                        last = False
+                    if use8:  # (f1 too)
+                        err2, C1, S1 = rk8_step(field, mode, tau, C, S, hs, om, n, u, f0, pp,
+                                                mem, rtol, atol, us, K8, u1, f1)
+                    else:
+                        err2, C1, S1 = _rk_step(field, mode, tau, C, S, hs, om, n, u, f0, pp,
+                                                mem, rtol, atol, us, k1, k2, k3, k4, k5, u1)
                     if not err2 <= 1.0:
-                        h, finite = _shrink(err2, hs)
+                        h, finite = shrink8(err2, hs) if use8 else _shrink(err2, hs)
                         rejected = True
                         if h < hmin:
                             code = st.STEP_TOO_SMALL if finite else st.NON_FINITE
                             break
                         continue
-                    field(mode, tau + hs, C1, S1, u1, pp, mem, f1)
+                    if use8:  # its dense output: the step is a polynomial piece for the
+                        rk8_dense(field, mode, tau, C, S, hs, om, n, u, u1, f1, pp, mem, us, K8,
+                                  TW)  # guards and extrema, as a series piece
+                        pd = True
+                    else:
+                        field(mode, tau + hs, C1, S1, u1, pp, mem, f1)
 
                 # ---- exit test for every guard; earliest crossing located by Illinois ----
                 s_best = 2.0
@@ -1655,12 +1680,12 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
                 En = -1.0  # energy norm of a closed-form piece, when needed
                 for k in range(ng):
                     curv = ncv > 0 and math.isnan(G[k, n])
-                    if pm or curv:  # a series piece's polynomial guard, or a curved one
-                        if not curv:
+                    if pm or pd or curv:  # a polynomial guard (a series piece, a DOP853
+                        if not curv:  # step's dense output), or a curved one
                             guard_poly(G, k, n, TW, cp)
                         lo, hi = _guard_exit(1 if curv else 0, cp, curved, mode, k, tau, C, S,
                                              hs, om, n, u, f0, u1, f1, pp, mem, gr, us, stack,
-                                             s_best, pm, TW)
+                                             s_best, pm or pd, TW)
                         if hi < 0.0:
                             code = st.EVENT_FAILED
                             break
@@ -1773,7 +1798,7 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
                         else:
                             err2, C1, S1 = _retake(field, pm, mode, tau, C, S, hs, om, n, u, f0,
                                                    pp, mem, rtol, atol, us, k1, k2, k3, k4, k5,
-                                                   u1, f1, TW)
+                                                   u1, f1, TW, use8, K8)
                             if ncv > 0 and math.isnan(G[k_tr, n]):
                                 # a curved guard: Newton on the true g of the retaken step's
                                 # end (the interpolant is a cubic, the step 5th order), kept
@@ -1794,7 +1819,7 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
                                     hs += dh
                                     err2, C1, S1 = _retake(field, pm, mode, tau, C, S, hs, om, n,
                                                            u, f0, pp, mem, rtol, atol, us, k1,
-                                                           k2, k3, k4, k5, u1, f1, TW)
+                                                           k2, k3, k4, k5, u1, f1, TW, use8, K8)
                                     g2, d2 = _curved_rate(curved, mode, k_tr, tau + hs, C1, S1,
                                                           n, u1, f1, pp, mem, gr)
                                     if not abs(g2) < abs(gn):  # no better: back, and stop
@@ -1802,7 +1827,7 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
                                         err2, C1, S1 = _retake(field, pm, mode, tau, C, S, hs,
                                                                om, n, u, f0, pp, mem, rtol,
                                                                atol, us, k1, k2, k3, k4, k5,
-                                                               u1, f1, TW)
+                                                               u1, f1, TW, use8, K8)
                                         break
                                     gn, dn = g2, d2
                         if not math.isfinite(u1[0]):
@@ -1822,13 +1847,18 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
                     # step-size control after an accepted step without a switch; with tangent
                     # vectors, also by their error (at rest the state's estimate is 0, and a
                     # step of a whole period would give the tangent of the RK polynomial)
-                    h = _control(max(err2, errY2), hs, h, last, rejected)
+                    if use8:
+                        h = control8(err2, hs, h, last, rejected)
+                    else:
+                        h = _control(max(err2, errY2), hs, h, last, rejected)
                     rejected = False
                 if cf:
                     xmax, xmin = _x_extrema_exact(MC, mode, om, MF[mode], y0, z0, C, S, u[0],
                                                   u[1], u1[0], u1[1], hs, xmax, xmin)
                 elif pm:
                     xmax, xmin = poly_x_extrema(TW, hs, xmax, xmin, cp, MXR[mode])
+                elif pd:  # the DOP853 step's dense output, sampled as a series piece
+                    xmax, xmin = poly_x_extrema(TW, hs, xmax, xmin, cp, THETA_POLY / hs)
                 else:
                     xmax, xmin = _x_extrema(u[0], f0[0], u1[0], f1[0], hs, xmax, xmin)
                 for i in range(n):
@@ -1836,7 +1866,7 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
                     f0[i] = f1[i]
                 C = C1
                 S = S1
-                gv = k_tr < 0 and not pm and ncv == 0
+                gv = k_tr < 0 and not pm and not pd and ncv == 0
                 tau = t_end if last else tau + hs
                 xmax = max(xmax, u[0])
                 xmin = min(xmin, u[0])

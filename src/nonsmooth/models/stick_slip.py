@@ -303,7 +303,12 @@ def exact_initial(c, s, u, p, mem):
 
 
 def exact_linear(mode, p, out):
-    if mode == STICK or p[_VS] > 0.0:
+    if mode == STICK:  # X' = v_belt, V' = 0: the general linear form (A = 0, b = (v_belt, 0))
+        for i in range(10):
+            out[i] = 0.0
+        out[4] = p[_VB]
+        return 2
+    if p[_VS] > 0.0:
         return 0
     k = p[_W0] * p[_W0]
     d = k - p[_OM] * p[_OM]
