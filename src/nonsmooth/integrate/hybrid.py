@@ -12,9 +12,11 @@ Design summary
   output times hit by shortening the last step without disturbing the controller), as in
   :mod:`.rkf45`; each step holds the field of the current mode fixed. A plain run (no tangent
   columns) at rtol below ``rk8.HI_ORDER_RTOL`` (the exact methods' nonlinear modes at 1e-12)
-  takes DOP853 steps instead (:mod:`.rk8`): a crossing located on the step's cubic Hermite is
-  then refined by Newton steps on the true guard at the retaken step's end, and an extremum
-  of X by retaken partial steps.
+  takes DOP853 steps instead (:mod:`.rk8`). A cubic Hermite of so long a step would miss a
+  grazing dip, so each accepted DOP853 step computes its dense output (order 7) into the
+  Taylor terms TW and is treated as a series piece (below): guards as polynomials with the
+  certified exit test, the crossing by Newton on them, extrema of X; the step is then retaken
+  (a true DOP853 step) up to the crossing.
 * Guards are affine in (u, cos, sin): inside a mode every g_k >= 0. After an accepted step the
   exit test is g_k(end) < 0, or a negative value of g_k (on the step's cubic Hermite state
   interpolant, exact forcing) at an interior minimum of the Hermite of (g, g'). The earliest
