@@ -791,3 +791,50 @@ def test_rk8_dense_output_is_scipys_dop853_interpolant():
         assert got[2] == 1.0
         assert abs(got[3] - math.cos(om * (tau + s))) < 1e-15
         assert abs(got[4] - math.sin(om * (tau + s))) < 1e-15
+
+
+def _rk8_step_and_tangent(field, jacobian, u, mem, h, om, Y):
+    """``_rk_step_and_tangent`` for the DOP853 step (``rk8.rk8_step``, ``rk8.rk8_tangent``)."""
+    from nonsmooth.integrate import rk8
+
+    n = u.shape[0]
+    m = Y.shape[1]
+    p = np.zeros(1)
+    C, S = math.cos(0.7), math.sin(0.7)
+    k0, us, u1, f1 = np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n)
+    K = np.zeros((16, n))
+    field(0, 0.3, C, S, u, p, mem, k0)
+    rk8.rk8_step(field, 0, 0.3, C, S, h, om, n, u, k0, p, mem, 1e-8, 1e-10, us, K, u1, f1)
+    rk8.rk8_tangent(jacobian, 0, 0.3, C, S, h, om, n, u, K, p, mem, Y, np.zeros(n),
+                    np.zeros((rk8.N_STAGES8, n, m)), np.zeros((n, n + 2)), us,
+                    np.ones(1, np.int64), 1e-8, 1e-10)
+    return u1
+
+
+@pytest.mark.parametrize("n", [2, 4])
+def test_rk8_tangent_is_the_derivative_of_the_rk8_step(n):
+    """The tangent of a DOP853 step (the runs at rtol below 1e-10), memory slot 1 as a
+    continuous coordinate, equals central differences of the same step in u and in the
+    slot."""
+    rng = np.random.default_rng(n)
+    u = rng.uniform(-1.0, 1.0, n)
+    mem = np.array([1.0, 0.8])
+    h, om = 0.37, 1.3
+    Y = np.eye(n + 1)
+    _rk8_step_and_tangent(coupled_field, coupled_jacobian, u, mem, h, om, Y)
+    eps = 1e-6
+    F = np.zeros((n, n + 1))
+    for j in range(n + 1):
+        up, um, mp, mm = u.copy(), u.copy(), mem.copy(), mem.copy()
+        if j < n:
+            up[j] += eps
+            um[j] -= eps
+        else:
+            mp[1] += eps
+            mm[1] -= eps
+        F[:, j] = (_rk8_step_and_tangent(coupled_field, coupled_jacobian, up, mp, h, om,
+                                         np.zeros((n + 1, 0)))
+                   - _rk8_step_and_tangent(coupled_field, coupled_jacobian, um, mm, h, om,
+                                           np.zeros((n + 1, 0)))) / (2 * eps)
+    assert np.max(np.abs(Y[:n] - F)) <= 1e-8 * np.max(np.abs(F))
+    assert np.array_equal(Y[n], np.eye(n + 1)[n])

@@ -10,9 +10,9 @@ Design summary
 * A mode's field is integrated with the RKF45 table of :mod:`.tableau` (local extrapolation,
   elementary controller h err^(-1/5) with ``pow_fast``, RMS error norm over the n components,
   output times hit by shortening the last step without disturbing the controller), as in
-  :mod:`.rkf45`; each step holds the field of the current mode fixed. A plain run (no tangent
-  columns) at rtol below ``rk8.HI_ORDER_RTOL`` (the exact methods' nonlinear modes at 1e-12)
-  takes DOP853 steps instead (:mod:`.rk8`). A cubic Hermite of so long a step would miss a
+  :mod:`.rkf45`; each step holds the field of the current mode fixed. A run at rtol below
+  ``rk8.HI_ORDER_RTOL`` (the exact methods' nonlinear modes at 1e-12) takes DOP853 steps
+  instead (:mod:`.rk8`), its tangent columns too (``rk8_tangent``). A cubic Hermite of so long a step would miss a
   grazing dip, so each accepted DOP853 step computes its dense output (order 7) into the
   Taylor terms TW and is treated as a series piece (below): guards as polynomials with the
   certified exit test, the crossing by Newton on them, extrema of X; the step is then retaken
@@ -107,7 +107,8 @@ from .record import record_interval  # noqa: E402
 from .roots import illinois_point, illinois_update, quad_roots01  # noqa: E402
 from .rkstep import (_A, _B, _C, _E, _FM, _NS, _control, _cubic, _shrink,  # noqa: E402
                      _x_extrema)
-from .rk8 import HI_ORDER_RTOL, control8, rk8_dense, rk8_step, shrink8  # noqa: E402
+from .rk8 import (HI_ORDER_RTOL, N_STAGES8, control8, rk8_dense, rk8_step,  # noqa: E402
+                  rk8_tangent, shrink8)
 from .trig import cos_sin_small  # noqa: E402
 from .workspace import keep_alive, unowned, view  # noqa: E402
 
@@ -1428,7 +1429,7 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
     nlin = max(4, n * n + 3 * n)  # a ``linear`` row: (k, c, b, F), or (A, b, f_c, f_s)
     m3 = n + 3
     sizes = (len(p), 26 * n, nme, MAX_GUARDS * (n + 3), MAX_MODES * (N_MC + 7), nlin,
-             N_BD * (1 + MAX_GUARDS), (SCAN_DEPTH + 1) * 5, _NS * nt * mt, 6 * nt + nt * nj,
+             N_BD * (1 + MAX_GUARDS), (SCAN_DEPTH + 1) * 5, N_STAGES8 * nt * mt, 6 * nt + nt * nj,
              _NS * nt * nj if nt == 2 or nt == 4 else 0,
              2 * nme if tan else 0, len(cmi), mt, n + 1,
              MAX_MODES + (N_TAYLOR + 1) * (m3 + 1) + n * n + n + 2 * MAX_GUARDS)
@@ -1467,8 +1468,8 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
     o += MAX_GUARDS * N_BD
     stack = view(ws, o, (SCAN_DEPTH + 1, 5))
     o += (SCAN_DEPTH + 1) * 5
-    KY = view(ws, o, (_NS, nt, mt))
-    o += _NS * nt * mt
+    KY = view(ws, o, (N_STAGES8, nt, mt))  # the tangent's stages (RKF45: the first 6)
+    o += N_STAGES8 * nt * mt
     rows = view(ws, o, (6, nt))
     W, ue, fm, gk, uc, ua = rows[0], rows[1], rows[2], rows[3], rows[4], rows[5]
     J = view(ws, o + 6 * nt, (nt, nj))
@@ -1513,8 +1514,8 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
     rtol = opts[OPT_RTOL]
     atol = opts[OPT_ATOL]
     closed = opts[OPT_CLOSED_FORM] == 1.0
-    # plain runs at a tight tolerance integrate by DOP853 (``rk8``); tangent runs by the RKF45
-    use8 = not tan and rtol < HI_ORDER_RTOL
+    # a tight tolerance integrates by DOP853 (``rk8``), its tangent too
+    use8 = rtol < HI_ORDER_RTOL
     om4 = (om * om) * (om * om)
     for q in range(len(cmi)):
         if cmi[q] < 0 or cmi[q] >= nmem:
@@ -1841,6 +1842,9 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
                         _cf_tangent(MC, mode, om, hs, Y, PT)
                     elif pm:
                         poly_tangent(PW[mode], n, hs, Y, PE, pt)
+                    elif use8:
+                        errY2 = rk8_tangent(jacobian, mode, tau, C, S, hs, om, n, u, K8, pp, mem,
+                                            Y, W, KY, J, us, cmi, rtol, atol)
                     else:
                         errY2 = _rk_tangent(jacobian, mode, tau, C, S, hs, om, n, u, f0, k1, k2,
                                             k3, k4, k5, pp, mem, Y, W, KY, J, JS, us, cmi,
@@ -1850,7 +1854,7 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
                     # vectors, also by their error (at rest the state's estimate is 0, and a
                     # step of a whole period would give the tangent of the RK polynomial)
                     if use8:
-                        h = control8(err2, hs, h, last, rejected)
+                        h = control8(max(err2, errY2), hs, h, last, rejected)
                     else:
                         h = _control(max(err2, errY2), hs, h, last, rejected)
                     rejected = False

@@ -185,3 +185,67 @@ def rk8_dense(field, mode, tau, C, S, h, om, n, u, u1, f1, pp, mem, us, K, TW):
         sj = a if r == 1 else (-a if r == 3 else 0.0)
         TW[n + 1, j] = C * cj - S * sj
         TW[n + 2, j] = S * cj + C * sj
+
+
+@nb.njit(cache=True, fastmath=_FM)
+def rk8_tangent(jacobian, mode, tau, C, S, h, om, n, u, K, pp, mem, Y, W, KY, J, us, cmi, rtol,
+                atol):
+    """Propagate the tangent Y (rows: u, then the continuous memory slots ``cmi``) through the
+    DOP853 step just taken (its stages K, length h): the same Runge-Kutta formula applied to
+    Y' = J Y with J the model's Jacobian at each stage state, the exact derivative of the
+    discrete step (as ``hybrid._rk_tangent`` for the RKF45). Returns the squared norm of the
+    step's error estimate on the tangent (Hairer's combination, each column scaled by
+    atol + rtol max|column|); the estimate's weight on the field at the step's end is zero, so
+    no Jacobian is taken there."""
+    m = Y.shape[1]
+    ncm = len(cmi)
+    for i in range(N_STAGES8):
+        for r in range(n):
+            acc = 0.0
+            for j in range(i):
+                acc += _A8[i, j] * K[j, r]
+            us[r] = u[r] + h * acc
+        for q in range(ncm):
+            for r in range(n):
+                J[r, n + cmi[q]] = 0.0
+        cs, sn = cos_sin_small(om * (_C8[i] * h))
+        jacobian(mode, tau + _C8[i] * h, C * cs - S * sn, S * cs + C * sn, us, pp, mem, J)
+        for c in range(m):
+            for r in range(n):
+                acc = 0.0
+                for j in range(i):
+                    acc += _A8[i, j] * KY[j, r, c]
+                W[r] = Y[r, c] + h * acc
+            for r in range(n):
+                acc = 0.0
+                for q in range(n):
+                    acc += J[r, q] * W[q]
+                for q in range(ncm):
+                    acc += J[r, n + cmi[q]] * Y[n + q, c]
+                KY[i, r, c] = acc
+    e5 = 0.0
+    e3 = 0.0
+    for c in range(m):
+        scale = 0.0
+        for r in range(n):
+            acc = 0.0
+            for j in range(N_STAGES8):
+                acc += _B8[j] * KY[j, r, c]
+            Y[r, c] += h * acc
+            scale = max(scale, abs(Y[r, c]))
+        sc = atol + rtol * scale
+        for r in range(n):
+            a5 = 0.0
+            a3 = 0.0
+            for j in range(N_STAGES8):
+                a5 += _E5[j] * KY[j, r, c]
+                a3 += _E3[j] * KY[j, r, c]
+            a5 = a5 / sc
+            a3 = a3 / sc
+            e5 += a5 * a5
+            e3 += a3 * a3
+    den = e5 + 0.01 * e3
+    if not den > 0.0:
+        return 0.0
+    err = abs(h) * e5 / math.sqrt(den * max(m * n, 1))
+    return err * err
