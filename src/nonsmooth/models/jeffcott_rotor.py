@@ -119,7 +119,9 @@ MODEL = model_from_equations(
                         "gravity pulls the whirl down: period one, rubbing at the bottom of "
                         "each turn"),
         "chaotic_rub": ({"e": 0.2, "g": 0.5, "omega": 1.2},
-                        "chaotic rubbing (lambda1 about +0.045 per unit time)"),
+                        "transient chaos: chaotic rubbing (lambda1 about +0.05 per unit "
+                        "time while it lasts) for hundreds to thousands of periods, then a "
+                        "stable period-two rub orbit (|multipliers| 0.905, 0.388)"),
         "no_rub": ({"e": 0.05}, "small unbalance: whirl inside the clearance"),
     },
 )
