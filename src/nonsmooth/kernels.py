@@ -36,6 +36,7 @@ from .integrate.contract import (
     OPT_N,
     OPT_NMEM,
     OPT_FRAME_PERIOD,
+    OPT_NO_DOP853,
     OPT_OMEGA,
     OPT_PHASE,
     OPT_RTOL,
@@ -233,6 +234,7 @@ class Solver:
         o[OPT_NMEM] = self.model.n_memory
         o[OPT_CLOSED_FORM] = 1.0 if m.closed_form else 0.0
         o[OPT_PHASE] = self.section_phase
+        o[OPT_NO_DOP853] = 0.0 if m.dop853 else 1.0
         return o
 
     def attrs(self) -> dict:

@@ -33,7 +33,8 @@ OPT_NMEM = 6  # number of discrete memory slots (generic kernel)
 OPT_CLOSED_FORM = 7  # 1: propagate the modes a model declares linear in closed form (generic)
 OPT_PHASE = 8  # forcing phase psi = omega t_s of the section (generic): periods start at t_s
 OPT_FRAME_PERIOD = 9  # 1: p[opts[OPT_OMEGA]] is the forcing period T, omega = 2 pi / T
-N_OPTS = 10
+OPT_NO_DOP853 = 10  # 1: the RKF45 even below rk8.HI_ORDER_RTOL (Method.dop853 False; generic)
+N_OPTS = 11
 
 # state layout
 ST_X = 0

@@ -86,6 +86,7 @@ from .contract import (  # noqa: E402
     OPT_MAX_STEPS,
     OPT_N,
     OPT_NMEM,
+    OPT_NO_DOP853,
     OPT_PHASE,
     OPT_OMEGA,
     OPT_RTOL,
@@ -1514,8 +1515,8 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
     rtol = opts[OPT_RTOL]
     atol = opts[OPT_ATOL]
     closed = opts[OPT_CLOSED_FORM] == 1.0
-    # a tight tolerance integrates by DOP853 (``rk8``), its tangent too
-    use8 = rtol < HI_ORDER_RTOL
+    # a tight tolerance integrates by DOP853 (``rk8``), its tangent too, unless the method says
+    use8 = rtol < HI_ORDER_RTOL and opts[OPT_NO_DOP853] != 1.0
     om4 = (om * om) * (om * om)
     for q in range(len(cmi)):
         if cmi[q] < 0 or cmi[q] >= nmem:

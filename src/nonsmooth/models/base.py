@@ -247,7 +247,10 @@ class Method:
     n + i of J (J has n + n_memory columns, the memory ones zeroed before each call).
     ``admissible``: None, or a plain Python function ``admissible(u, params) -> bool`` telling
     whether a state may start a trajectory (a ball above its table), with ``admissible_text``
-    saying what it requires; analyses refuse other starts in one line."""
+    saying what it requires; analyses refuse other starts in one line. ``dop853``: the generic
+    kernel integrates modes without closed form by DOP853 where the tolerance is below 1e-10
+    (``integrate.rk8``); False keeps the RKF45 there, for a method whose such modes are crossed
+    in a few short steps (a thin band), where 6 stages a step cost less than 15."""
 
     field: Callable
     jacobian: Callable
@@ -267,6 +270,7 @@ class Method:
     admissible: Callable | None = None
     admissible_text: str = ""
     curved: Callable | None = None
+    dop853: bool = True
 
 
 def _no_linear(mode, p, out):

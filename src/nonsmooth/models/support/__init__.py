@@ -69,6 +69,7 @@ MODEL = Model(
             g.smooth_field, g.smooth_jacobian, g.smooth_guards, g.smooth_transition,
             g.smooth_initial, g.smooth_linear, closed_form=True, modes=(0, 1, 2, 3),
             flow_is_homeomorphism=True, continuous_memory=(0,), rtol=1e-12, atol=1e-14,
+            dop853=False,  # Sigma_alpha, a thin band, is crossed in a few short steps
             description="switch model, eqs. 10-14, solved exactly: closed form in Gamma-, "
                         "Sigma_beta and Gamma+, RKF45 at rtol 1e-12 in Sigma_alpha (whose "
                         "field uses the entry velocity Va)"),
