@@ -728,12 +728,19 @@ def test_rk_tangent_is_the_derivative_of_the_rk_step(n):
     """The tangent of an RKF45 step (the two- and four-state paths written in scalars, the
     general loop for 3 and 5 states), memory slot 1 as a continuous coordinate, equals central
     differences of the same step in u and in the slot."""
+    _check_tangent_against_differences(_rk_step_and_tangent, n)
+
+
+def _check_tangent_against_differences(step_and_tangent, n):
+    """The tangent that ``step_and_tangent`` carries through one step of ``coupled_field`` from
+    a random point (every direction: the step's whole Jacobian) against central differences
+    of the same step in u and in memory slot 1."""
     rng = np.random.default_rng(n)
     u = rng.uniform(-1.0, 1.0, n)
     mem = np.array([1.0, 0.8])
     h, om = 0.37, 1.3
-    Y = np.eye(n + 1)  # every direction: the step's whole Jacobian
-    _rk_step_and_tangent(coupled_field, coupled_jacobian, u, mem, h, om, Y)
+    Y = np.eye(n + 1)
+    step_and_tangent(coupled_field, coupled_jacobian, u, mem, h, om, Y)
     eps = 1e-6
     F = np.zeros((n, n + 1))
     for j in range(n + 1):
@@ -744,10 +751,10 @@ def test_rk_tangent_is_the_derivative_of_the_rk_step(n):
         else:
             mp[1] += eps
             mm[1] -= eps
-        F[:, j] = (_rk_step_and_tangent(coupled_field, coupled_jacobian, up, mp, h, om,
-                                        np.zeros((n + 1, 0)))
-                   - _rk_step_and_tangent(coupled_field, coupled_jacobian, um, mm, h, om,
-                                          np.zeros((n + 1, 0)))) / (2 * eps)
+        F[:, j] = (step_and_tangent(coupled_field, coupled_jacobian, up, mp, h, om,
+                                    np.zeros((n + 1, 0)))
+                   - step_and_tangent(coupled_field, coupled_jacobian, um, mm, h, om,
+                                      np.zeros((n + 1, 0)))) / (2 * eps)
     assert np.max(np.abs(Y[:n] - F)) <= 1e-8 * np.max(np.abs(F))
     assert np.array_equal(Y[n], np.eye(n + 1)[n])  # the memory row is constant in a mode
 
@@ -816,25 +823,4 @@ def test_rk8_tangent_is_the_derivative_of_the_rk8_step(n):
     """The tangent of a DOP853 step (the runs at rtol below 1e-10), memory slot 1 as a
     continuous coordinate, equals central differences of the same step in u and in the
     slot."""
-    rng = np.random.default_rng(n)
-    u = rng.uniform(-1.0, 1.0, n)
-    mem = np.array([1.0, 0.8])
-    h, om = 0.37, 1.3
-    Y = np.eye(n + 1)
-    _rk8_step_and_tangent(coupled_field, coupled_jacobian, u, mem, h, om, Y)
-    eps = 1e-6
-    F = np.zeros((n, n + 1))
-    for j in range(n + 1):
-        up, um, mp, mm = u.copy(), u.copy(), mem.copy(), mem.copy()
-        if j < n:
-            up[j] += eps
-            um[j] -= eps
-        else:
-            mp[1] += eps
-            mm[1] -= eps
-        F[:, j] = (_rk8_step_and_tangent(coupled_field, coupled_jacobian, up, mp, h, om,
-                                         np.zeros((n + 1, 0)))
-                   - _rk8_step_and_tangent(coupled_field, coupled_jacobian, um, mm, h, om,
-                                           np.zeros((n + 1, 0)))) / (2 * eps)
-    assert np.max(np.abs(Y[:n] - F)) <= 1e-8 * np.max(np.abs(F))
-    assert np.array_equal(Y[n], np.eye(n + 1)[n])
+    _check_tangent_against_differences(_rk8_step_and_tangent, n)

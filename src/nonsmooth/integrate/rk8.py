@@ -28,7 +28,7 @@ import numba as nb
 import numpy as np
 from scipy.integrate._ivp import dop853_coefficients as _dop
 
-from .rkstep import _FAC_MAX, _FAC_MIN, _FM, _SAFETY, pow_fast
+from .rkstep import _FM, control_step, shrink_step
 from .trig import cos_sin_small
 
 N_STAGES8 = 12
@@ -98,21 +98,14 @@ def rk8_step(field, mode, tau, C, S, h, om, n, u, k0, pp, mem, rtol, atol, us, K
 
 @nb.njit(cache=True, inline="always", fastmath=_FM)
 def shrink8(err2, hs):
-    """``rkstep._shrink`` with the exponent of DOP853's error estimate."""
-    finite = math.isfinite(err2)
-    fac = max(_FAC_MIN, _SAFETY * pow_fast(err2, -0.5 * _EXPO8)) if finite else _FAC_MIN
-    return hs * fac, finite
+    """``rkstep.shrink_step`` with the exponent of DOP853's error estimate."""
+    return shrink_step(err2, hs, _EXPO8)
 
 
 @nb.njit(cache=True, inline="always", fastmath=_FM)
 def control8(err2, hs, h, last, rejected):
-    """``rkstep._control`` with the exponent of DOP853's error estimate."""
-    fac = _SAFETY * pow_fast(max(err2, 1e-30), -0.5 * _EXPO8)
-    fac = min(_FAC_MAX, max(_FAC_MIN, fac))
-    if rejected:
-        fac = min(fac, 1.0)
-    h_new = hs * fac
-    return max(h, h_new) if last else h_new
+    """``rkstep.control_step`` with the exponent of DOP853's error estimate."""
+    return control_step(err2, hs, h, last, rejected, _EXPO8)
 
 
 @nb.njit(cache=True, fastmath=_FM)

@@ -64,21 +64,34 @@ def _x_extrema(X, V, X1, V1, h, xmax, xmin):
 
 
 @nb.njit(cache=True, inline="always", fastmath=_FM)
-def _shrink(err2, hs):
+def shrink_step(err2, hs, expo):
     """Step size after rejecting a step of length hs with squared error norm err2 (not
-    <= 1); returns (h, err2 finite)."""
+    <= 1), for an error estimate of order 1/expo - 1; returns (h, err2 finite)."""
     finite = math.isfinite(err2)
-    fac = max(_FAC_MIN, _SAFETY * pow_fast(err2, -0.5 * _EXPO)) if finite else _FAC_MIN
+    fac = max(_FAC_MIN, _SAFETY * pow_fast(err2, -0.5 * expo)) if finite else _FAC_MIN
     return hs * fac, finite
 
 
 @nb.njit(cache=True, inline="always", fastmath=_FM)
-def _control(err2, hs, h, last, rejected):
-    """Step-size control after an accepted step of length hs with squared error norm err2;
-    a shortened last step of an output interval does not shrink h. Returns the new h."""
-    fac = _SAFETY * pow_fast(max(err2, 1e-30), -0.5 * _EXPO)
+def control_step(err2, hs, h, last, rejected, expo):
+    """Step-size control after an accepted step of length hs with squared error norm err2,
+    for an error estimate of order 1/expo - 1; a shortened last step of an output interval
+    does not shrink h. Returns the new h."""
+    fac = _SAFETY * pow_fast(max(err2, 1e-30), -0.5 * expo)
     fac = min(_FAC_MAX, max(_FAC_MIN, fac))
     if rejected:
         fac = min(fac, 1.0)
     h_new = hs * fac
     return max(h, h_new) if last else h_new
+
+
+@nb.njit(cache=True, inline="always", fastmath=_FM)
+def _shrink(err2, hs):
+    """``shrink_step`` for the RKF45."""
+    return shrink_step(err2, hs, _EXPO)
+
+
+@nb.njit(cache=True, inline="always", fastmath=_FM)
+def _control(err2, hs, h, last, rejected):
+    """``control_step`` for the RKF45."""
+    return control_step(err2, hs, h, last, rejected, _EXPO)
