@@ -767,7 +767,7 @@ def test_rk8_dense_output_is_scipys_dop853_interpolant():
     from scipy.integrate import DOP853
 
     from nonsmooth.integrate import rk8
-    from nonsmooth.integrate.linmodes import N_TAYLOR
+    from nonsmooth.integrate.linmodes import N_TAYLOR, pval7
 
     om, tau, h = 1.3, 0.4 / 1.3, 0.2
     C, S = math.cos(om * tau), math.sin(om * tau)
@@ -798,6 +798,10 @@ def test_rk8_dense_output_is_scipys_dop853_interpolant():
         assert got[2] == 1.0
         assert abs(got[3] - math.cos(om * (tau + s))) < 1e-15
         assert abs(got[4] - math.sin(om * (tau + s))) < 1e-15
+        for i in range(2):  # the kernel's degree-7 evaluation of these rows, and its derivative
+            v, d = pval7(TW[i], s)
+            assert abs(v - got[i]) < 1e-15
+            assert abs(d - np.polyval(np.polyder(TW[i][:8][::-1]), s)) < 1e-14
 
 
 def _rk8_step_and_tangent(field, jacobian, u, mem, h, om, Y):

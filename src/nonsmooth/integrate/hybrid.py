@@ -102,7 +102,7 @@ from .pwlinear import (BD_D2, BD_D3, BD_D4, BD_R, EXCLUDED, HERM_ERR, MC_A,  # n
                        energy_norm, eval_state, functional_bounds, herm_clear, herm_coeffs,
                        hom_part, jerk, mode_coeffs, propagator)
 from .linmodes import (N_TAYLOR, POLY_DEPTH, THETA_POLY, guard_poly, lin_matrix,  # noqa: E402
-                       poly_component, poly_m4, poly_root, poly_state, poly_tangent,
+                       poly_component, poly_m4, poly_root, poly_state, poly_tangent, pval7,
                        poly_x_extrema, pval, series_powers, taylor_terms)
 from .record import record_interval  # noqa: E402
 from .roots import illinois_point, illinois_update, quad_roots01  # noqa: E402
@@ -606,9 +606,19 @@ def _curved_at(curved, mode, k, tau, C, S, hs, om, n, u, f0, u1, f1, pp, mem, gr
                pm, TW):
     """(g, dg/dt) of curved guard k at the fraction s of the step (tau, u) -> (tau + hs, u1),
     on the step's cubic Hermite state interpolant (``us`` <- that state) with exact forcing;
-    on a piece of a linear mode (``pm``), on its series (exact)."""
+    on a piece of a linear mode (``pm`` 1), on its series (exact); on a DOP853 step's dense
+    output (``pm`` 2), on that polynomial of degree 7 (``pval7``)."""
     th = om * (s * hs)
-    if pm:
+    if pm == 2:
+        for i in range(n):
+            us[i] = pval7(TW[i], s * hs)[0]
+        g = curved(mode, k, tau + s * hs, C * math.cos(th) - S * math.sin(th),
+                   S * math.cos(th) + C * math.sin(th), us, pp, mem, gr)
+        d = gr[n]
+        for i in range(n):
+            d += gr[i] * pval7(TW[i], s * hs)[1]
+        return g, d
+    if pm == 1:
         poly_state(TW, n, s * hs, us)
         g = curved(mode, k, tau + s * hs, C * math.cos(th) - S * math.sin(th),
                    S * math.cos(th) + C * math.sin(th), us, pp, mem, gr)
@@ -1689,7 +1699,7 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
                             guard_poly(G, k, n, TW, cp)
                         lo, hi = _guard_exit(1 if curv else 0, cp, curved, mode, k, tau, C, S,
                                              hs, om, n, u, f0, u1, f1, pp, mem, gr, us, stack,
-                                             s_best, pm or pd, TW)
+                                             s_best, 2 if pd else (1 if pm else 0), TW)
                         if hi < 0.0:
                             code = st.EVENT_FAILED
                             break

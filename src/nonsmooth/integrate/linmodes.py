@@ -182,6 +182,18 @@ def pval(c, s):
 
 
 @nb.njit(cache=True, inline="always", fastmath={"contract"})
+def pval7(c, s):
+    """``pval`` of a polynomial of degree 7 at most (c[0:8]: a DOP853 step's dense output,
+    ``rk8.rk8_dense``): Horner in s^2 over the two parities of the exponent."""
+    s2 = s * s
+    a0 = ((c[6] * s2 + c[4]) * s2 + c[2]) * s2 + c[0]
+    a1 = ((c[7] * s2 + c[5]) * s2 + c[3]) * s2 + c[1]
+    d0 = (7.0 * c[7] * s2 + 5.0 * c[5]) * s2 + 3.0 * c[3]
+    d1 = (6.0 * c[6] * s2 + 4.0 * c[4]) * s2 + 2.0 * c[2]
+    return a0 + s * a1, (d0 * s2 + c[1]) + s * d1
+
+
+@nb.njit(cache=True, inline="always", fastmath={"contract"})
 def pvalue(c, s):
     """p(s) alone (``pval``, inlined: the derivative's chains are dead code there)."""
     return pval(c, s)[0]
