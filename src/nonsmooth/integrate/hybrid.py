@@ -12,10 +12,11 @@ Design summary
   output times hit by shortening the last step without disturbing the controller), as in
   :mod:`.rkf45`; each step holds the field of the current mode fixed. A run at rtol below
   ``rk8.HI_ORDER_RTOL`` (the exact methods' nonlinear modes at 1e-12) takes DOP853 steps
-  instead (:mod:`.rk8`), its tangent columns too (``rk8_tangent``). A cubic Hermite of so long a step would miss a
-  grazing dip, so each accepted DOP853 step computes its dense output (order 7) into the
-  Taylor terms TW and is treated as a series piece (below): guards as polynomials with the
-  certified exit test, the crossing by Newton on them, extrema of X; the step is then retaken
+  instead (:mod:`.rk8`), its tangent columns too (``rk8_tangent``). A cubic Hermite of so
+  long a step would miss a grazing dip, so each accepted DOP853 step computes its dense
+  output (order 7) into the Taylor terms TW and is treated as a series piece (below): guards
+  as polynomials with the certified exit test, the crossing by Newton on them, extrema of X
+  (a curved guard on the dense rows of degree 7, ``pval7``); the step is then retaken
   (a true DOP853 step) up to the crossing.
 * Guards are affine in (u, cos, sin): inside a mode every g_k >= 0. After an accepted step the
   exit test is g_k(end) < 0, or a negative value of g_k (on the step's cubic Hermite state
@@ -103,13 +104,14 @@ from .pwlinear import (BD_D2, BD_D3, BD_D4, BD_R, EXCLUDED, HERM_ERR, MC_A,  # n
                        hom_part, jerk, mode_coeffs, propagator)
 from .linmodes import (N_TAYLOR, POLY_DEPTH, THETA_POLY, guard_poly, lin_matrix,  # noqa: E402
                        poly_component, poly_m4, poly_root, poly_state, poly_tangent, pval7,
-                       poly_x_extrema, pval, series_powers, taylor_terms)
+                       pvalue, poly_x_extrema, pval, series_powers, taylor_terms)
 from .record import record_interval  # noqa: E402
 from .roots import illinois_point, illinois_update, quad_roots01  # noqa: E402
 from .rkstep import (_A, _B, _C, _E, _FM, _NS, _control, _cubic, _shrink,  # noqa: E402
+                     control_step, shrink_step, tangent_stage,
                      _x_extrema)
-from .rk8 import (HI_ORDER_RTOL, N_STAGES8, control8, rk8_dense, rk8_step,  # noqa: E402
-                  rk8_tangent, shrink8)
+from .rk8 import (EXPO8, HI_ORDER_RTOL, N_STAGES8, rk8_dense, rk8_step,  # noqa: E402
+                  rk8_tangent)
 from .trig import cos_sin_small  # noqa: E402
 from .workspace import keep_alive, unowned, view  # noqa: E402
 
@@ -609,22 +611,15 @@ def _curved_at(curved, mode, k, tau, C, S, hs, om, n, u, f0, u1, f1, pp, mem, gr
     on a piece of a linear mode (``pm`` 1), on its series (exact); on a DOP853 step's dense
     output (``pm`` 2), on that polynomial of degree 7 (``pval7``)."""
     th = om * (s * hs)
-    if pm == 2:
+    if pm:
         for i in range(n):
-            us[i] = pval7(TW[i], s * hs)[0]
+            us[i] = pval7(TW[i], s * hs)[0] if pm == 2 else pvalue(TW[i], s * hs)
         g = curved(mode, k, tau + s * hs, C * math.cos(th) - S * math.sin(th),
                    S * math.cos(th) + C * math.sin(th), us, pp, mem, gr)
         d = gr[n]
         for i in range(n):
-            d += gr[i] * pval7(TW[i], s * hs)[1]
-        return g, d
-    if pm == 1:
-        poly_state(TW, n, s * hs, us)
-        g = curved(mode, k, tau + s * hs, C * math.cos(th) - S * math.sin(th),
-                   S * math.cos(th) + C * math.sin(th), us, pp, mem, gr)
-        d = gr[n]
-        for i in range(n):
-            d += gr[i] * poly_component(TW, i, s * hs)[1]
+            d += gr[i] * (pval7(TW[i], s * hs)[1] if pm == 2 else
+                          poly_component(TW, i, s * hs)[1])
         return g, d
     for i in range(n):
         du = u1[i] - u[i]
@@ -1247,19 +1242,7 @@ def _rk_tangent(jacobian, mode, tau, C, S, h, om, n, u, k0, k1, k2, k3, k4, k5, 
             for r in range(n):
                 J[r, n + cmi[q]] = 0.0
         jacobian(mode, tau + _C[i] * h, C * cw - S * sw, S * cw + C * sw, us, pp, mem, J)
-        for c in range(m):
-            for r in range(n):  # the stages before this one (_A is strictly lower triangular)
-                acc = 0.0
-                for j in range(i):
-                    acc += _A[i, j] * KY[j, r, c]
-                W[r] = Y[r, c] + h * acc
-            for r in range(n):
-                acc = 0.0
-                for q in range(n):
-                    acc += J[r, q] * W[q]
-                for q in range(ncm):
-                    acc += J[r, n + cmi[q]] * Y[n + q, c]
-                KY[i, r, c] = acc
+        tangent_stage(_A, i, h, n, J, Y, W, KY, cmi)
     b0, b1, b2, b3, b4, b5 = _B[0], _B[1], _B[2], _B[3], _B[4], _B[5]
     err2 = 0.0
     for c in range(m):
@@ -1675,7 +1658,7 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
                         err2, C1, S1 = _rk_step(field, mode, tau, C, S, hs, om, n, u, f0, pp,
                                                 mem, rtol, atol, us, k1, k2, k3, k4, k5, u1)
                     if not err2 <= 1.0:
-                        h, finite = shrink8(err2, hs) if use8 else _shrink(err2, hs)
+                        h, finite = shrink_step(err2, hs, EXPO8) if use8 else _shrink(err2, hs)
                         rejected = True
                         if h < hmin:
                             code = st.STEP_TOO_SMALL if finite else st.NON_FINITE
@@ -1865,7 +1848,7 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
                     # vectors, also by their error (at rest the state's estimate is 0, and a
                     # step of a whole period would give the tangent of the RK polynomial)
                     if use8:
-                        h = control8(max(err2, errY2), hs, h, last, rejected)
+                        h = control_step(max(err2, errY2), hs, h, last, rejected, EXPO8)
                     else:
                         h = _control(max(err2, errY2), hs, h, last, rejected)
                     rejected = False

@@ -12,7 +12,7 @@ the derivative of its step (``hybrid._rk_tangent``).
   computed as the 13th (it is the next step's first, and the kernel needs it anyway).
 * The error: Hairer's combination of the 5th- and 3rd-order estimates,
   err = |h| e5 / sqrt(n (e5 + 0.01 e3)) with e5, e3 the squared scaled norms; the step-size
-  controller's exponent is 1/8 (``control8``, ``shrink8``).
+  controller's exponent is 1/8 (``EXPO8``, for ``rkstep.control_step``).
 * Events and extrema: a cubic Hermite of a step is far coarser than an 8th-order step (it
   would miss a grazing dip inside it), so every accepted step also computes its dense output
   of order 7 (three more stages, ``rk8_dense``) and the kernel treats the step as a series
@@ -28,22 +28,35 @@ import numba as nb
 import numpy as np
 from scipy.integrate._ivp import dop853_coefficients as _dop
 
-from .rkstep import _FM, control_step, shrink_step
+from .rkstep import _FM, tangent_stage
 from .trig import cos_sin_small
 
 N_STAGES8 = 12
 _A8 = np.ascontiguousarray(_dop.A[:N_STAGES8, :N_STAGES8])
 _B8 = np.ascontiguousarray(_dop.B)
 _C8 = np.ascontiguousarray(_dop.C[:N_STAGES8])
-_E5 = np.ascontiguousarray(_dop.E5)  # over the 12 stages and the field at the step's end
-_E3 = np.ascontiguousarray(_dop.E3)
+_E5 = np.ascontiguousarray(_dop.E5[:N_STAGES8])  # (their 13th weight, on the field at the
+_E3 = np.ascontiguousarray(_dop.E3[:N_STAGES8])  # step's end, is zero)
+assert _dop.E5[N_STAGES8] == 0.0 and _dop.E3[N_STAGES8] == 0.0
 _AX = np.ascontiguousarray(_dop.A[N_STAGES8 + 1:])  # the dense output's three extra stages
 _CX = np.ascontiguousarray(_dop.C[N_STAGES8 + 1:])
 _D8 = np.ascontiguousarray(_dop.D)  # F3..F6 of the interpolant from the 16 stages
-_EXPO8 = 1.0 / 8.0  # the error estimate is of order 7: h_new = 0.9 h err^(-1/8)
+EXPO8 = 1.0 / 8.0  # the error estimate is of order 7: h_new = 0.9 h err^(-1/8)
 
 #: the plain generic kernel takes DOP853 steps (not RKF45) where rtol is below this
 HI_ORDER_RTOL = 1e-10
+
+
+@nb.njit(cache=True, inline="always", fastmath=_FM)
+def _err2(e5, e3, h, count):
+    """The squared error norm of a DOP853 step from the squared scaled norms e5, e3 of its
+    5th- and 3rd-order estimates over ``count`` components (Hairer's combination); 0 when both
+    are 0, NaN when they are not finite."""
+    den = e5 + 0.01 * e3
+    if not den > 0.0:
+        return 0.0 if den == 0.0 else np.nan
+    err = abs(h) * e5 / math.sqrt(den * count)
+    return err * err
 
 
 @nb.njit(cache=True, fastmath=_FM)
@@ -79,8 +92,8 @@ def rk8_step(field, mode, tau, C, S, h, om, n, u, k0, pp, mem, rtol, atol, us, K
     e5 = 0.0
     e3 = 0.0
     for i in range(n):
-        a5 = _E5[N_STAGES8] * f1[i]
-        a3 = _E3[N_STAGES8] * f1[i]
+        a5 = 0.0  # (the estimates' weights on the field at the end, f1, are zero)
+        a3 = 0.0
         for j in range(N_STAGES8):
             a5 += _E5[j] * K[j, i]
             a3 += _E3[j] * K[j, i]
@@ -89,23 +102,7 @@ def rk8_step(field, mode, tau, C, S, h, om, n, u, k0, pp, mem, rtol, atol, us, K
         a3 = a3 / sc
         e5 += a5 * a5
         e3 += a3 * a3
-    den = e5 + 0.01 * e3
-    if not den > 0.0:
-        return 0.0 if den == 0.0 else np.nan, C1, S1
-    err = abs(h) * e5 / math.sqrt(den * n)
-    return err * err, C1, S1
-
-
-@nb.njit(cache=True, inline="always", fastmath=_FM)
-def shrink8(err2, hs):
-    """``rkstep.shrink_step`` with the exponent of DOP853's error estimate."""
-    return shrink_step(err2, hs, _EXPO8)
-
-
-@nb.njit(cache=True, inline="always", fastmath=_FM)
-def control8(err2, hs, h, last, rejected):
-    """``rkstep.control_step`` with the exponent of DOP853's error estimate."""
-    return control_step(err2, hs, h, last, rejected, _EXPO8)
+    return _err2(e5, e3, h, n), C1, S1
 
 
 @nb.njit(cache=True, fastmath=_FM)
@@ -203,19 +200,7 @@ def rk8_tangent(jacobian, mode, tau, C, S, h, om, n, u, K, pp, mem, Y, W, KY, J,
                 J[r, n + cmi[q]] = 0.0
         cs, sn = cos_sin_small(om * (_C8[i] * h))
         jacobian(mode, tau + _C8[i] * h, C * cs - S * sn, S * cs + C * sn, us, pp, mem, J)
-        for c in range(m):
-            for r in range(n):
-                acc = 0.0
-                for j in range(i):
-                    acc += _A8[i, j] * KY[j, r, c]
-                W[r] = Y[r, c] + h * acc
-            for r in range(n):
-                acc = 0.0
-                for q in range(n):
-                    acc += J[r, q] * W[q]
-                for q in range(ncm):
-                    acc += J[r, n + cmi[q]] * Y[n + q, c]
-                KY[i, r, c] = acc
+        tangent_stage(_A8, i, h, n, J, Y, W, KY, cmi)
     e5 = 0.0
     e3 = 0.0
     for c in range(m):
@@ -237,8 +222,5 @@ def rk8_tangent(jacobian, mode, tau, C, S, h, om, n, u, K, pp, mem, Y, W, KY, J,
             a3 = a3 / sc
             e5 += a5 * a5
             e3 += a3 * a3
-    den = e5 + 0.01 * e3
-    if not den > 0.0:
-        return 0.0
-    err = abs(h) * e5 / math.sqrt(den * max(m * n, 1))
-    return err * err
+    err2 = _err2(e5, e3, h, max(m * n, 1))
+    return err2 if err2 == err2 else 0.0  # (a NaN estimate leaves the control to the state)

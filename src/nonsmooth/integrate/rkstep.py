@@ -95,3 +95,26 @@ def _shrink(err2, hs):
 def _control(err2, hs, h, last, rejected):
     """``control_step`` for the RKF45."""
     return control_step(err2, hs, h, last, rejected, _EXPO)
+
+
+@nb.njit(cache=True, inline="always", fastmath=_FM)
+def tangent_stage(A, i, h, n, J, Y, W, KY, cmi):
+    """Stage i of an explicit Runge-Kutta step applied to the variational equation Y' = J Y
+    (J: the Jacobian at stage i's state; its columns n + slot the field's dependence on the
+    continuous memory slots ``cmi``, whose rows of Y are constant in a mode): for each
+    column c, KY[i, :, c] = J (Y[:, c] + h sum_{j < i} A[i, j] KY[j, :, c]) plus the memory
+    columns times Y's memory rows."""
+    ncm = len(cmi)
+    for c in range(Y.shape[1]):
+        for r in range(n):  # the stages before this one (A is strictly lower triangular)
+            acc = 0.0
+            for j in range(i):
+                acc += A[i, j] * KY[j, r, c]
+            W[r] = Y[r, c] + h * acc
+        for r in range(n):
+            acc = 0.0
+            for q in range(n):
+                acc += J[r, q] * W[q]
+            for q in range(ncm):
+                acc += J[r, n + cmi[q]] * Y[n + q, c]
+            KY[i, r, c] = acc
