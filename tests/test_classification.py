@@ -97,3 +97,39 @@ def test_benettin_stops_at_its_error_target_and_short_records_run_whole(monkeypa
     short = stability.lambda1_points(P, solver, S, 400)
     monkeypatch.setattr(stability, "REL_STDERR", 1.0)
     assert np.array_equal(short[0], stability.lambda1_points(P, solver, S, 400)[0])
+
+
+def test_smooth_sweep_evidence_is_the_closed_form_tangent_of_the_same_equations():
+    """support's ``smooth`` names ``smooth_closed_form`` (the same switch model solved
+    exactly) for its lambda1 evidence: a periodic point without contact gets the linear
+    oscillator's -xi / 2 to rounding (the RKF45 tangent at 1e-8 was 1.5e-7 off), and a
+    period-3 contact orbit the Floquet lambda1 of the orbit converged by Newton's shooting
+    at rtol 1e-12 (the RKF45: 1.6e-7)."""
+    params = ns.preset("table3")
+    b = ns.bifurcation_diagram(params, "omega", [0.82, 0.86], sweep="up")
+    assert b.lambda1.attrs["tangent_method"] == "smooth_closed_form"
+    assert b.attrs["method"] == "smooth"
+    assert int(b.period[0, 0]) == 1 and int(b.contact[0, 0]) == 0
+    assert float(b.lambda1[0, 0]) == pytest.approx(-params.xi / 2, rel=1e-12)
+    k = int(b.period[0, 1])
+    assert k == 3
+    p = params.replace(omega=0.86)
+    orb = ns.periodic_orbit(p, k=k, x0=float(b.X[0, 1, -1]), v0=float(b.V[0, 1, -1]),
+                            method="smooth_closed_form", rtol=1e-12, atol=1e-14)
+    assert orb.attrs["status"] == "converged"
+    lam = math.log(float(orb.multiplier_abs[0])) / (k * p.period)
+    assert float(b.lambda1[0, 1]) == pytest.approx(lam, rel=2e-8)
+
+
+def test_an_evidence_method_must_solve_the_same_equations():
+    from dataclasses import replace
+
+    from nonsmooth.errors import ParameterError
+    m = ns.model("support")
+    methods = dict(m.methods)
+    methods["smooth_eq12"] = replace(methods["smooth_eq12"], evidence="smooth_closed_form")
+    with pytest.raises(ParameterError) as exc:
+        replace(m, name="support_variant", methods=methods)
+    msg = str(exc.value)
+    assert "\n" not in msg and "smooth_eq12" in msg and "evidence" in msg
+    assert ns.model("two_sided").method("smooth").evidence == "smooth_closed_form"

@@ -597,7 +597,7 @@ def branches_dataset(params, param, values, solver, directions, out, **attrs) ->
     desc, unit = spec.long_name, spec.units
     dims = ("sweep", param)
     nfail = int(np.count_nonzero(out["status"]))
-    extra = {k: (dims, out[k], a) for k, a in lyapunov_attrs(attrs["record"]).items()
+    extra = {k: (dims, out[k], a) for k, a in lyapunov_attrs(attrs["record"], solver).items()
              if k in out}
     ds = xr.Dataset(
         {

@@ -208,7 +208,7 @@ def _dataset(params, solver, xname, xs, yname, ys, out, attrs) -> xr.Dataset:
     from .poincare import MAX_PERIOD, PERIOD_LONG_NAME
     from .stability import lyapunov_attrs
     dims = (yname, xname)
-    lyap = {k: (dims, out[k], a) for k, a in lyapunov_attrs(attrs["record"]).items()
+    lyap = {k: (dims, out[k], a) for k, a in lyapunov_attrs(attrs["record"], solver).items()
             if k in out}
     if "lambda1" in lyap:
         lyap["lambda1"][2]["periods"] = attrs["record"]

@@ -16,6 +16,7 @@ them (the entry velocity counts only when the section point lies inside Sigma_al
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import numba as nb
@@ -453,6 +454,17 @@ def _lambda1_many(tangent, fns, P, opts, states, align, periods, N, cmi, logs, s
             Ys[i, r] = Y[r, 0]
 
 
+def generic_states(states, rows: int, reclassify: bool) -> np.ndarray:
+    """A copy of kernel ``states`` (``rows`` of them) for the generic kernel: with
+    ``reclassify`` (states of a specialised kernel or of another method) mode -1 and step
+    size 0, so that the kernel classifies each point and chooses its step."""
+    S = np.array(states, dtype=np.float64, copy=True).reshape(rows, -1)
+    if reclassify:
+        S[:, ST_MODE] = -1.0
+        S[:, ST_H] = 0.0
+    return S
+
+
 #: Benettin's lambda1 of a non-periodic point runs in stages: FIRST_STAGE periods, then stages
 #: of a quarter of the periods done (at least FIRST_STAGE / 2), and stops once its standard
 #: error is at most REL_STDERR |lambda1| (or the record is used up): a record of at most
@@ -474,10 +486,7 @@ def lambda1_points(P, solver, states, periods: int, *, blocks: int = 10, workers
     from ..sweep import deferred_interrupts, threads
     setup = TangentSetup(solver)
     P = np.array(np.atleast_2d(P), dtype=np.float64, order="C")  # writable, contiguous
-    S = np.array(states, dtype=np.float64, copy=True).reshape(P.shape[0], -1)
-    if solver.code != KERNEL_GENERIC:
-        S[:, ST_MODE] = -1.0
-        S[:, ST_H] = 0.0
+    S = generic_states(states, P.shape[0], solver.code != KERNEL_GENERIC)
     n = P.shape[0]
     om = solver.model.frequency(P)
     T = 2.0 * np.pi / om
@@ -539,10 +548,7 @@ def floquet_lambda1_points(P, solver, states, period, *, workers=None):
     from ..sweep import deferred_interrupts, threads
     setup = TangentSetup(solver)
     P = np.array(np.atleast_2d(P), dtype=np.float64, order="C")
-    S = np.array(states, dtype=np.float64, copy=True).reshape(P.shape[0], -1)
-    if solver.code != KERNEL_GENERIC:
-        S[:, ST_MODE] = -1.0
-        S[:, ST_H] = 0.0
+    S = generic_states(states, P.shape[0], solver.code != KERNEL_GENERIC)
     k = np.asarray(period, dtype=np.int64).ravel()
     n = P.shape[0]
     mono = np.zeros((n, setup.N, setup.N))
@@ -595,12 +601,27 @@ def wants_lyapunov(flag, solver) -> bool:
     return True if flag is None else bool(flag)
 
 
+def evidence_solver(solver, states):
+    """(solver, kernel states) for ``solver``'s lambda1 evidence from its ``states`` (one per
+    row): the method the model's method names as ``evidence`` (the same equations solved
+    more precisely and faster, e.g. support's ``smooth_closed_form`` for ``smooth``) with the
+    states re-classified for it, else ``solver`` and ``states`` themselves."""
+    name = solver.spec.evidence
+    if name is None:
+        return solver, states
+    states = np.atleast_2d(states)
+    return dataclasses.replace(solver, method=name), generic_states(states, states.shape[0],
+                                                                    True)
+
+
 def lambda1_evidence(P, solver, states, periods: int, period, *, workers=None):
     """(lambda1, stderr) of many points (rows of ``P``, kernel ``states`` on their attractors,
     detected ``period`` per point, > 0 periodic): a periodic point's lambda1 is ln|mu_1| / (p T)
     of its leading Floquet multiplier, from one tangent pass over its p periods
     (:func:`floquet_lambda1_points`, stderr 0: exact up to the orbit's settling); any other
-    point's is Benettin's estimate over ``periods`` periods (:func:`lambda1_points`)."""
+    point's is Benettin's estimate over ``periods`` periods (:func:`lambda1_points`); both by
+    the tangent dynamics of :func:`evidence_solver`."""
+    solver, states = evidence_solver(solver, states)
     per = np.asarray(period, dtype=np.int64).ravel()
     n = per.size
     lam = np.full(n, np.nan)
@@ -631,22 +652,24 @@ def lyapunov_variables(P, solver, states, periods: int, period, dims) -> dict:
     motion = classify_points(lam, err, period)
     if not dims:
         lam, err, motion = float(lam[0]), float(err[0]), np.int8(motion[0])
-    attrs = lyapunov_attrs(periods)
+    attrs = lyapunov_attrs(periods, solver)
     return {"lambda1": (dims, lam, attrs["lambda1"]),
             "lambda1_stderr": (dims, err, attrs["lambda1_stderr"]),
             "motion": (dims, motion, attrs["motion"])}
 
 
-def lyapunov_attrs(periods: int) -> dict:
+def lyapunov_attrs(periods: int, solver) -> dict:
     """CF attributes of the ``lambda1``, ``lambda1_stderr`` and ``motion`` variables of a
-    sweep (lambda1 over ``periods`` periods per point)."""
+    sweep (lambda1 over ``periods`` periods per point, by the tangent dynamics of
+    :func:`evidence_solver` of ``solver``: attribute ``tangent_method``)."""
     return {
         "lambda1": {"long_name": "largest Lyapunov exponent (tangent dynamics with saltation "
                                  "matrices): ln|mu_1| / (p T) of the leading Floquet "
                                  "multiplier at periodic points, Benettin's estimate over "
                                  "at most 'periods' periods elsewhere (ended once its "
                                  "standard error is below 5% of |lambda1|)", "units": "1/s",
-                    "periods": periods},
+                    "periods": periods,
+                    "tangent_method": solver.spec.evidence or solver.method},
         "lambda1_stderr": {"long_name": "standard error of lambda1 (10 block means; 0 at "
                                         "periodic points)", "units": "1/s"},
         "motion": motion_attrs(),

@@ -250,7 +250,15 @@ class Method:
     saying what it requires; analyses refuse other starts in one line. ``dop853``: the generic
     kernel integrates modes without closed form by DOP853 where the tolerance is below 1e-10
     (``integrate.rk8``); False keeps the RKF45 there, for a method whose such modes are crossed
-    in a few short steps (a thin band), where 6 stages a step cost less than 15."""
+    in a few short steps (a thin band), where 6 stages a step cost less than 15.
+    ``evidence``: None, or another method of the model that solves the same equations (the
+    same field, Jacobian, guards, transitions, initial classification, modes and memory)
+    more precisely and faster; the lambda1 evidence of sweeps (``bifurcation_diagram``,
+    ``poincare``, ``basins``, ``parameter_map``) is then computed by that method's tangent
+    dynamics from this method's attractor states (support's and two_sided's ``smooth``:
+    ``smooth_closed_form``, whose tangent dynamics cost a fifth of the RKF45's). lambda1 is
+    a property of the equations, not of the integrator; an explicit ``lyapunov_spectrum``
+    or ``floquet`` keeps the method asked for."""
 
     field: Callable
     jacobian: Callable
@@ -271,6 +279,7 @@ class Method:
     admissible_text: str = ""
     curved: Callable | None = None
     dop853: bool = True
+    evidence: str | None = None
 
 
 def _no_linear(mode, p, out):
@@ -347,6 +356,14 @@ class Model:
                 if not 0 <= mode < len(self.mode_names):
                     raise bad(f"method {mname!r}: mode {mode} is not one of the "
                               f"{len(self.mode_names)} modes")
+            if m.evidence is not None:
+                e = self.methods.get(m.evidence)
+                same = ("field", "jacobian", "guards", "transition", "initial", "modes",
+                        "continuous_memory")
+                if e is None or e.evidence is not None or any(
+                        getattr(e, k) != getattr(m, k) for k in same):
+                    raise bad(f"method {mname!r}: evidence {m.evidence!r} must name another "
+                              f"method with the same {', '.join(same)}")
         object.__setattr__(self, "_compiled", {})
 
     # ---- parameters ----

@@ -456,6 +456,7 @@ MODEL = Model(
         "smooth": Method(smooth_field, smooth_jacobian, smooth_guards, smooth_transition,
                          smooth_initial, modes=(0, 1, 2, 3, 4, 5, 6),
                          flow_is_homeomorphism=True, continuous_memory=(_VA_R, _VA_L),
+                         evidence="smooth_closed_form",
                          description="switch model (eq. 13) at each support, RKF45 with "
                                      "located switches"),
         "smooth_closed_form": Method(

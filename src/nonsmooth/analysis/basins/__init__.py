@@ -504,13 +504,13 @@ LYAPUNOV_PERIODS = 400
 
 def _attractor_lyapunov(found, solver, pk):
     """(lambda1, stderr) per attractor (order of ``found``), from its first section point."""
-    from ..stability import lambda1_points
+    from ..stability import evidence_solver, lambda1_points
     if not found.points:
         return np.zeros(0), np.zeros(0)
     states = np.stack([new_state(pts[0, 0], pts[0, 1]) if st0 is None else st0
                        for pts, st0 in zip(found.points, found.states)])
     P = np.tile(pk, (len(states), 1))
-    lam, err, _ = lambda1_points(P, solver, states, LYAPUNOV_PERIODS)
+    lam, err, _ = lambda1_points(P, *evidence_solver(solver, states), LYAPUNOV_PERIODS)
     return lam, err
 
 
@@ -551,7 +551,8 @@ def _dataset(params, solver, xs, vs, label, used, status, found, key, kind, cont
             "lambda1": ("attractor", lyap[0][key], {
                 "long_name": "largest Lyapunov exponent of the attractor (tangent dynamics with "
                              "saltation matrices)", "units": "1/s",
-                "periods": LYAPUNOV_PERIODS}),
+                "periods": LYAPUNOV_PERIODS,
+                "tangent_method": solver.spec.evidence or solver.method}),
             "lambda1_stderr": ("attractor", lyap[1][key], {
                 "long_name": "standard error of lambda1 (10 block means)", "units": "1/s"}),
         }

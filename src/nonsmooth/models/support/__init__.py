@@ -57,7 +57,7 @@ MODEL = Model(
         "smooth": Method(g.smooth_field, g.smooth_jacobian, g.smooth_guards,
                          g.smooth_transition, g.smooth_initial, modes=(0, 1, 2, 3),
                          flow_is_homeomorphism=True, kernel=KERNEL_SUPPORT_SMOOTH,
-                         continuous_memory=(0,),
+                         continuous_memory=(0,), evidence="smooth_closed_form",
                          description="switch model, eqs. 10-14 (RKF45, located switches)"),
         "smooth_eq12": Method(g.smooth_eq12_field, g.smooth_eq12_jacobian, g.smooth_guards,
                               g.smooth_transition, g.smooth_initial, modes=(0, 1, 2, 3),
