@@ -601,13 +601,19 @@ def wants_lyapunov(flag, solver) -> bool:
     return True if flag is None else bool(flag)
 
 
+def evidence_method(solver) -> str:
+    """The method whose tangent dynamics give ``solver``'s lambda1 evidence: the one its
+    method names as ``evidence`` (the same equations solved more precisely and faster, e.g.
+    support's ``smooth_closed_form`` for ``smooth``), else its own."""
+    return solver.spec.evidence or solver.method
+
+
 def evidence_solver(solver, states):
     """(solver, kernel states) for ``solver``'s lambda1 evidence from its ``states`` (one per
-    row): the method the model's method names as ``evidence`` (the same equations solved
-    more precisely and faster, e.g. support's ``smooth_closed_form`` for ``smooth``) with the
-    states re-classified for it, else ``solver`` and ``states`` themselves."""
-    name = solver.spec.evidence
-    if name is None:
+    row): :func:`evidence_method`, with the states re-classified for it when it is another
+    method, else ``solver`` and ``states`` themselves."""
+    name = evidence_method(solver)
+    if name == solver.method:
         return solver, states
     states = np.atleast_2d(states)
     return dataclasses.replace(solver, method=name), generic_states(states, states.shape[0],
@@ -669,7 +675,7 @@ def lyapunov_attrs(periods: int, solver) -> dict:
                                  "at most 'periods' periods elsewhere (ended once its "
                                  "standard error is below 5% of |lambda1|)", "units": "1/s",
                     "periods": periods,
-                    "tangent_method": solver.spec.evidence or solver.method},
+                    "tangent_method": evidence_method(solver)},
         "lambda1_stderr": {"long_name": "standard error of lambda1 (10 block means; 0 at "
                                         "periodic points)", "units": "1/s"},
         "motion": motion_attrs(),

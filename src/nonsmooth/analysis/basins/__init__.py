@@ -547,12 +547,13 @@ def _dataset(params, solver, xs, vs, label, used, status, found, key, kind, cont
     failed = int(np.count_nonzero(status != 0))
     lyap_vars = {}
     if lyap is not None:
+        from ..stability import evidence_method
         lyap_vars = {
             "lambda1": ("attractor", lyap[0][key], {
                 "long_name": "largest Lyapunov exponent of the attractor (tangent dynamics with "
                              "saltation matrices)", "units": "1/s",
                 "periods": LYAPUNOV_PERIODS,
-                "tangent_method": solver.spec.evidence or solver.method}),
+                "tangent_method": evidence_method(solver)}),
             "lambda1_stderr": ("attractor", lyap[1][key], {
                 "long_name": "standard error of lambda1 (10 block means)", "units": "1/s"}),
         }
