@@ -105,8 +105,8 @@ def test_errors_are_one_line():
     p = M.params()
     with pytest.raises(ParameterError, match=r"limit_cycle: the system is forced \(F0 = 0.3\)"):
         ns.limit_cycle(p.replace(F0=0.3), "V")
-    with pytest.raises(ParameterError, match="section: .* is not affine in the state"):
-        ns.limit_cycle(p, "X*V")
+    with pytest.raises(ParameterError, match="section: cannot read"):
+        ns.limit_cycle(p, "X*(V")
     with pytest.raises(ParameterError, match="section: unknown name"):
         ns.surface_section(p, "Q - 1")
     with pytest.raises(ParameterError, match="section: direction must be one of"):
@@ -230,6 +230,61 @@ def scipy_stick_slip(p, x0, v0, t_end=1000.0, window=200.0):
         if sol.status == 1:
             u[1] = vb
     return last_stick > t_end - window, u
+
+
+def test_a_curved_section_gives_the_closed_form_cycle_and_the_same_period_and_multiplier():
+    """A curved section (issue 23, item 3): the parabola X - mu_k/omega0^2 + V^2/2 = 0
+    through the slip arc's centre, crossed once per turn. The Coulomb stick-slip cycle found on
+    it has the closed form's period and multiplier 0 (a property of the cycle, not of the
+    section), and its section point lies on the closed form's slip arc and on the surface."""
+    p = M.params()
+    period, max_x = coulomb_cycle(p)
+    xc = p.mu_k / p.omega0**2
+    amp = max_x - xc
+    lc = ns.limit_cycle(p, f"X - {xc!r} + V**2/2", v0=1.0)
+    assert lc.attrs["status"] == "converged" and lc.attrs["section"].endswith("decreasing")
+    assert float(lc.period) == pytest.approx(period, abs=1e-9)
+    assert lc.sizes["multiplier"] == 1 and float(lc.multiplier_abs[0]) < 1e-9
+    X, V = float(lc.X_section), float(lc.V_section)
+    assert abs(X - xc + V**2 / 2) < 1e-12
+    assert math.hypot(X - xc, V / p.omega0) == pytest.approx(amp, abs=1e-9)
+    assert V < 0.0  # the arc's lower half: there h decreases along the flow
+
+
+VDP = """import nonsmooth as ns
+MODEL = ns.model_from_equations(
+    "van_der_pol", states=("X", "V"), parameters={"mu": 1.0},
+    modes={"flow": ["V", "mu*(1 - X**2)*V - X"]}, omega=None)
+"""
+
+
+def test_crossings_of_a_curved_section_against_scipy_events():
+    """The van der Pol oscillator's crossings of the circle X^2 + V^2 = 4 outwards: states
+    and return times against scipy's DOP853 with the same surface as a located event."""
+    from scipy.integrate import solve_ivp
+    g = {}
+    exec(VDP, g)
+    p = g["MODEL"].params()
+    sec = ns.surface_section(p, ("X**2 + V**2 - 4", "increasing"), x0=0.5, crossings=6,
+                             transient=2)
+    ev = lambda t, u: u[0]**2 + u[1]**2 - 4  # noqa: E731
+    ev.direction = 1.0
+    sol = solve_ivp(lambda t, u: [u[1], (1 - u[0]**2) * u[1] - u[0]], (0, 60), [0.5, 0.0],
+                    method="DOP853", rtol=1e-12, atol=1e-12, events=ev)
+    ref, tref = sol.y_events[0][2:8], sol.t_events[0][1:8]
+    assert np.allclose(sec.X.values, ref[:, 0], atol=1e-9, rtol=0)
+    assert np.allclose(sec.V.values, ref[:, 1], atol=1e-9, rtol=0)
+    assert np.allclose(sec.return_time.values, np.diff(tref), atol=1e-9, rtol=0)
+    # the cycle crosses the circle outwards twice per turn: a fixed point of the second return,
+    # the same cycle as on V = 0 (period and multiplier belong to the cycle)
+    circle = ns.limit_cycle(p, ("X**2 + V**2 - 4", "increasing"), x0=0.5, crossings=2)
+    line = ns.limit_cycle(p, "V", x0=0.5)
+    assert circle.attrs["status"] == line.attrs["status"] == "converged"
+    assert float(circle.period) == pytest.approx(float(line.period), abs=1e-9)
+    assert float(circle.multiplier_real[0]) == pytest.approx(float(line.multiplier_real[0]),
+                                                              rel=1e-6)
+    assert int(ns.surface_section(p, ("X**2 + V**2 - 4", "increasing"), x0=0.5, crossings=6,
+                                  transient=20).cycle_crossings) == 2
 
 
 def test_surface_basins_share_of_the_stick_slip_cycle_against_scipy():
@@ -429,6 +484,28 @@ def test_limit_cycles_continued_through_their_fold_against_the_closed_form(tmp_p
                             "Y - mu", "--x0", "1.5"], capsys)
     assert code == 2
     one_line(err, "names the continued parameter mu")
+
+
+def test_cycles_continued_on_a_curved_section_through_their_fold_against_the_closed_form():
+    """The fold-of-cycles system's branch, continued on the parabola Y = X^2 / 5 (curved: the
+    section point's coordinate is measured on its tangent line, moved back onto it along the
+    normal): every point on the closed form's cycles, the fold at mu = -1."""
+    ns_ = {}
+    exec(FOLD_MODEL, ns_)
+    p = ns_["MODEL"].params()
+    br = ns.continuation(p, "mu", section=("Y - X**2/5", "increasing"), x0=1.5,
+                         direction="down", step=0.05, bounds=(-1.5, -0.05))
+    assert br.attrs["status"] == "left the bounds"
+    X, Y = br.X_section.values[:, 0], br.V_section.values[:, 0]
+    assert np.abs(Y - X**2 / 5).max() < 1e-12
+    s = X**2 + Y**2
+    assert np.allclose(br.mu.values, s**2 - 2 * s, atol=1e-9, rtol=0)
+    assert np.allclose(br.period.values, 2 * math.pi, atol=1e-9, rtol=0)
+    assert np.allclose(br.multiplier_real.values[:, 0], np.exp(8 * math.pi * s * (1 - s)),
+                       rtol=1e-6, atol=1e-12)
+    assert (s > 1.4).any() and (s < 0.3).any()  # both sides of the fold
+    assert list(br.special_type.values) == [1]
+    assert float(br.special_mu[0]) == pytest.approx(-1.0, abs=1e-8)
 
 
 def test_stick_slip_cycle_continued_in_the_belt_speed_against_its_closed_form():

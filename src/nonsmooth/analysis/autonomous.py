@@ -7,16 +7,21 @@ A system is autonomous when its field does not depend on time: a model whose for
 frequency then only sets the kernel's time unit T = 2 pi / omega (step budgets, output
 intervals), never a number of the results.
 
-* **Section surface** h(u) = a . u + b = 0, crossed in a direction (``"decreasing"``: h from
-  positive to negative, the default; ``"increasing"``; ``"both"``): given as an expression affine
-  in the state, with the model's parameters allowed (``"V"``, ``"X - delta"``,
-  ``("V - v_belt", "increasing")``). Crossings are located by the kernel like switching events
-  (``hybrid.advance_tangent`` with a section row), to the kernel's event tolerance.
+* **Section surface** h(u) = 0, crossed in a direction (``"decreasing"``: h from
+  positive to negative, the default; ``"increasing"``; ``"both"``): given as an expression in
+  the state, with the model's parameters allowed (``"V"``, ``"X - delta"``,
+  ``("V - v_belt", "increasing")``, ``"X**2 + V**2 - 4"``). Crossings are located by the
+  kernel like switching events (``hybrid.advance_tangent`` with a section row), to the
+  kernel's event tolerance: an affine h = a . u + b as an affine row; any other as a curved
+  guard (:class:`Surface`: h and its gradient a(u), derived by SymPy, compiled into the
+  ``curved`` function of the flow's ``fns``, ``contract.SECTION_K``).
 * **Return map** P: a point z on the section to the next crossing in the direction; its time is
   the return time. Its Jacobian from the flow's tangent Phi (saltation matrices at the
-  switches included) and the field f at the crossing: dP = (I - f a^T / (a . f)) Phi.
+  switches included) and the field f at the crossing: dP = (I - f a^T / (a . f)) Phi, a the
+  gradient there.
 * **Limit cycle** (:func:`limit_cycle`): Newton's method for P(z) = z on the section's
-  coordinates (an orthonormal basis B of a^perp): (B^T dP B - I) dw = -B^T (P(z) - z); the
+  coordinates (an orthonormal basis B of a(z)^perp, the tangent plane at z): (B^T dP B - I) dw
+  = -B^T (P(z) - z), the step z + B dw moved back onto a curved surface along a(z); the
   period is the return time. The Floquet multipliers are the eigenvalues of B^T dP B, the
   n - 1 nontrivial ones (the trivial multiplier 1, along the flow, is removed).
 * **Equilibria** (:func:`equilibria`): Newton on f(mode, u) = 0 in every mode of the method,
@@ -87,20 +92,125 @@ def parse_section(params, section):
         raise ParameterError(f"section: unknown name(s) {', '.join(sorted(unknown))} in "
                              f"{section!r} (state: {', '.join(model.state_names)}; parameters "
                              f"allowed)")
-    expr = expr.subs({names[nm]: float(getattr(params, nm)) for nm in model.param_names})
-    coeffs = [sp.diff(expr, s) for s in states]
-    if any(sp.simplify(sp.diff(c, s)) != 0 for c in coeffs for s in states):
-        raise ParameterError(f"section: {section!r} is not affine in the state (curved "
-                             f"sections are not supported yet)")
-    try:
-        a = np.array([float(c) for c in coeffs])
-        b = float(expr.subs({s: 0 for s in states}))
-    except TypeError:
-        raise ParameterError(f"section: {section!r} is not affine in the state") from None
-    if not np.any(a != 0.0) or not np.all(np.isfinite(a)) or not math.isfinite(b):
+    if not any(expr.has(x) for x in states):
         raise ParameterError(f"section: {section!r} does not depend on the state")
-    H = np.concatenate([a, [b, 0.0, 0.0]])
-    return H, DIRECTIONS[direction], f"{section} = 0, {direction}"
+    text = f"{section} = 0, {direction}"
+    fixed = expr.subs({names[nm]: float(getattr(params, nm)) for nm in model.param_names})
+    coeffs = [sp.diff(fixed, s) for s in states]
+    if all(sp.simplify(sp.diff(c, s)) == 0 for c in coeffs for s in states):
+        try:
+            a = np.array([float(c) for c in coeffs])
+            b = float(fixed.subs({s: 0 for s in states}))
+        except TypeError:
+            raise ParameterError(f"section: {section!r} is not affine in the state") from None
+        if not np.any(a != 0.0) or not np.all(np.isfinite(a)) or not math.isfinite(b):
+            raise ParameterError(f"section: {section!r} does not depend on the state")
+        return Surface(np.concatenate([a, [b, 0.0, 0.0]]), DIRECTIONS[direction], text)
+    pars = [names[nm] for nm in model.param_names]
+    return Surface(np.concatenate([np.zeros(model.n), [math.nan, 0.0, 0.0]]),
+                   DIRECTIONS[direction], text, curved=(expr, states, pars))
+
+
+class Surface:
+    """A section surface h(u) = 0 crossed in ``direction`` (the kernel's SEC[0]): affine, the
+    row H = (a, b, 0, 0) with h = a . u + b; or curved (H[n] NaN), h any smooth expression of
+    the state and the parameters, which the kernel evaluates with its gradient through the
+    ``curved`` function of :meth:`fns` (``contract.SECTION_K``)."""
+
+    def __init__(self, H, direction, text, curved=None):
+        self.H, self.direction, self.text, self.expr = H, direction, text, curved
+        n = H.shape[0] - 3
+        if curved is None:
+            a = H[:n].copy()
+            self.value = lambda u, p: float(a @ u[:n] + H[n])
+            self.gradient = lambda u, p: a
+        else:
+            import sympy as sp
+            expr, states, pars = curved
+            args = (sp.MatrixSymbol("_u", n, 1), sp.MatrixSymbol("_q", len(pars) + 1, 1))
+            rep = {x: args[0][i, 0] for i, x in enumerate(states)}
+            rep.update({q: args[1][i, 0] for i, q in enumerate(pars)})
+            h = sp.lambdify(args, expr.xreplace(rep), "math")
+            dh = sp.lambdify(args, [sp.diff(expr, x).xreplace(rep) for x in states], "math")
+            col = lambda v: np.asarray(v, float).reshape(-1, 1)  # noqa: E731
+            self.value = lambda u, p: float(h(col(u[:n]), col(p)))
+            self.gradient = lambda u, p: np.array(dh(col(u[:n]), col(p)), float)
+
+    @property
+    def curved(self) -> bool:
+        return self.expr is not None
+
+    def basis(self, z, p):
+        """An orthonormal basis (n x (n - 1)) of the surface's tangent plane at z."""
+        a = self.gradient(z, p)
+        return np.linalg.svd(a[None, :])[2][1:].T
+
+    def project(self, z, a, p, iters: int = 8):
+        """z moved along the direction ``a`` onto the surface (Newton on h; z itself for an
+        affine surface whose row is ``a``, or when Newton does not converge)."""
+        z = np.array(z, float)
+        if not self.curved:
+            return z - (self.value(z, p) / float(a @ a)) * a
+        for _ in range(iters):
+            h = self.value(z, p)
+            d = float(self.gradient(z, p) @ a)
+            if not (math.isfinite(h) and d != 0.0):
+                break
+            z = z - (h / d) * a
+            if abs(h) <= 1e-15 * (1.0 + float(np.linalg.norm(z))):
+                break
+        return z
+
+    def fns(self, fns, model, method):
+        """The model's ``fns`` with its ``curved`` function answering the section too (k =
+        SECTION_K, SECTION_K + 1 for -h): a small cfunc compiled once per process and
+        surface."""
+        if not self.curved:
+            return fns
+        from ..integrate.contract import CompiledFunction, ModelFns
+        key = (model.name, method, self.text, id(fns))
+        got = _SECTION_FNS.get(key)
+        if got is None:
+            got = _SECTION_FNS[key] = ModelFns(tuple(fns[:6]) + (CompiledFunction(
+                _section_cfunc(self.expr, model, model.method(method).curved)),))
+        return got
+
+
+_SECTION_FNS: dict = {}
+
+
+def _section_cfunc(curved_expr, model, base):
+    """The cfunc ``curved(mode, k, t, c, s, u, p, mem, grad)`` of a curved section: k >=
+    SECTION_K gives h (SECTION_K) or -h with the gradient (state; 0 for time), any other k the
+    model's own ``base`` (its curved guards; NaN when it has none)."""
+    import numba as nb
+    import sympy as sp
+    from sympy.printing.pycode import PythonCodePrinter
+
+    from ..integrate.contract import MODEL_SIGNATURES, SECTION_K
+    expr, states, pars = curved_expr
+    n = len(states)
+    names = {x: sp.Symbol(f"_x{i}") for i, x in enumerate(states)}
+    names.update({q: sp.Symbol(f"_p{i}") for i, q in enumerate(pars)})
+    printer = PythonCodePrinter({"fully_qualified_modules": True, "standard": "python3"})
+    reps, red = sp.cse([expr] + [sp.diff(expr, x) for x in states],
+                       symbols=sp.numbered_symbols("_w"))
+    body = [f"        _x{i} = u[{i}]" for i in range(n)]
+    body += [f"        _p{i} = p[{i}]" for i in range(len(pars))]
+    body += [f"        {v} = {printer.doprint(e.xreplace(names))}" for v, e in reps]
+    body += ["        _sg = 1.0 if k == SECTION_K else -1.0"]
+    body += [f"        grad[{i}] = _sg * float({printer.doprint(e.xreplace(names))})"
+             for i, e in enumerate(red[1:])]
+    body += [f"        grad[{n}] = 0.0",
+             f"        return _sg * float({printer.doprint(red[0].xreplace(names))})"]
+    src = "\n".join(["def curved(mode, k, t, c, s, u, p, mem, grad):",
+                     "    if k >= SECTION_K:", *body,
+                     "    return base(mode, k, t, c, s, u, p, mem, grad)" if base is not None
+                     else "    return math.nan"]) + "\n"
+    ns_ = {"math": math, "SECTION_K": SECTION_K,
+           "base": nb.njit(base) if base is not None and not hasattr(base, "py_func") else base}
+    exec(compile(src, f"<section {model.name}>", "exec"), ns_)
+    return nb.cfunc(MODEL_SIGNATURES[6], error_model="numpy")(ns_["curved"])
 
 
 def check_autonomous(params, who: str, solver=None) -> None:
@@ -121,16 +231,15 @@ class _Flow:
     """The generic kernel with a section surface, from Python: crossings, the return map and
     its Jacobian."""
 
-    def __init__(self, params, solver, H, direction, max_time):
+    def __init__(self, params, solver, surface, max_time):
         from ..tangent import TangentSetup
         self.setup = TangentSetup(solver)
+        self.setup.fns = surface.fns(solver.fns, params.model, solver.method)
         self.model = params.model
         self.p = params.pack()
-        self.H = H
-        self.a = H[:self.model.n]
-        # an orthonormal basis (n x (n - 1)) of the section hyperplane's directions
-        self.basis = np.linalg.svd(self.a[None, :])[2][1:].T
-        self.direction = direction
+        self.surface = surface
+        self.H = surface.H
+        self.direction = surface.direction
         self.T = params.period
         self.budget = max(1, int(math.ceil(max_time / self.T)))
         self.max_time = max_time
@@ -177,11 +286,13 @@ class _Flow:
             return status, s, t, None
         n = self.model.n
         f = self.field(s)
-        af = float(self.a @ f)
-        if abs(af) <= 1e-12 * (np.linalg.norm(self.a) * np.linalg.norm(f) + 1e-300):
+        from ..simulate import state_u
+        a = self.surface.gradient(state_u(self.model, s), self.p)  # at the crossing
+        af = float(a @ f)
+        if abs(af) <= 1e-12 * (np.linalg.norm(a) * np.linalg.norm(f) + 1e-300):
             return "grazing the section (the flow is tangent to it)", s, t, None
         Phi = Y[:n, :n]
-        dP = Phi - np.outer(f, self.a @ Phi) / af
+        dP = Phi - np.outer(f, a @ Phi) / af
         return "ok", s, t, dP
 
 
@@ -201,11 +312,11 @@ def _setup(params, section, method, rtol, atol, max_time, who):
     params = check_params(params)
     solver = Solver(method=method, rtol=rtol, atol=atol, model=params.model)
     check_autonomous(params, who, solver)
-    H, direction, text = parse_section(params, section)
+    surface = parse_section(params, section)
     max_time = check_float("max_time", max_time)
     if not max_time > 0:
         raise ParameterError(f"max_time: must be > 0, got {max_time}")
-    return params, solver, _Flow(params, solver, H, direction, max_time), text
+    return params, solver, _Flow(params, solver, surface, max_time), surface.text
 
 
 def _xv(model, dims, U, what: str, suffix: str = "") -> dict:
@@ -426,13 +537,16 @@ def limit_cycle(params, section="V", *, x0: float = 0.0, v0: float = 0.0, u0=Non
     n = params.model.n
     u_start, s = _start(params, solver, x0, v0, u0)
     status, _, _, _, _ = flow.crossings(s, transient)
-    B = flow.basis
     from ..simulate import state_u
+    surface = flow.surface
     res, it, period, J = math.inf, 0, math.nan, None
     if status == "ok":
         status = "max_iter"
         for it in range(1, max_iter + 1):
             z = state_u(params.model, s)
+            # the tangent plane's basis at z (a curved surface: a Newton step along it is
+            # projected back onto the surface along the normal at z)
+            B = surface.basis(z, flow.p)
             got, s1, t1, dP = flow.return_map(s, crossings)
             if got != "ok":
                 status = got
@@ -449,7 +563,9 @@ def limit_cycle(params, section="V", *, x0: float = 0.0, v0: float = 0.0, u0=Non
             except np.linalg.LinAlgError:
                 status = "singular"
                 break
-            def trial(zt):
+            def trial(zt, a=surface.gradient(z, flow.p)):
+                if surface.curved:
+                    zt = surface.project(zt, a, flow.p)
                 st_t = _section_state(flow.setup, flow.p, zt, s)  # mode kept if it holds
                 s1t = st_t.copy()
                 got_t = flow.crossings(s1t, crossings)[0]
@@ -966,7 +1082,8 @@ class _CycleBranch:
 
     def __init__(self, params, param, solver, flow, z_ref, template, k, tol, level):
         self.params0, self.param, self.solver, self.flow = params, param, solver, flow
-        self.B = flow.basis
+        self.B = flow.surface.basis(z_ref, flow.p)
+        self.a_ref = flow.surface.gradient(z_ref, flow.p)
         self.z_ref, self.template, self.k, self.tol, self.level = z_ref, template, k, tol, level
         self.N = params.model.n - 1
 
@@ -975,7 +1092,11 @@ class _CycleBranch:
         return self.params0.replace(**{self.param: float(lam)}).pack()
 
     def z(self, w):
-        return self.z_ref + self.B @ w
+        """The section point of coordinates w: on the tangent plane at z_ref, moved along the
+        normal there onto a curved surface (at the parameter of ``flow.p``)."""
+        z = self.z_ref + self.B @ w
+        surface = self.flow.surface
+        return surface.project(z, self.a_ref, self.flow.p) if surface.curved else z
 
     def _map(self, w, lam, template, tangent):
         from ..simulate import state_u
@@ -994,7 +1115,10 @@ class _CycleBranch:
             s1, dP = s, None
         if got != "ok":
             return None
-        return s0, self.B.T @ state_u(self.params0.model, s1), t1, dP
+        Bz1 = self.B.T @ state_u(self.params0.model, s1)
+        if flow.surface.curved:  # F itself: z(w) moves with the parameter
+            Bz1 = Bz1 - self.B.T @ self.z(w)
+        return s0, Bz1, t1, dP
 
     def evaluate(self, w, lam):
         """(F, dF/dw, dF/dlam, start state, period) at (w, lam), or None."""
@@ -1002,8 +1126,14 @@ class _CycleBranch:
         if got is None:
             return None
         s0, Bz1, period, dP = got
-        F = Bz1 - self.B.T @ self.z(w)
-        J = self.B.T @ dP @ self.B - np.eye(self.N)
+        if self.flow.surface.curved:  # dz/dw = B - a_ref (g^T B) / (g . a_ref), g at z(w)
+            F = Bz1
+            g = self.flow.surface.gradient(self.z(w), self.flow.p)
+            Zw = self.B - np.outer(self.a_ref, g @ self.B) / float(g @ self.a_ref)
+            J = self.B.T @ dP @ Zw - np.eye(self.N)
+        else:
+            F = Bz1 - self.B.T @ self.z(w)
+            J = self.B.T @ dP @ self.B - np.eye(self.N)
         h = 1e-7 * max(1.0, abs(lam))
         up, down = (self._map(w, lam + sg * h, s0, False) for sg in (1.0, -1.0))
         self.flow.p = self.p(lam)

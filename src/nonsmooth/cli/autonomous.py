@@ -16,8 +16,8 @@ from .common import (DEFAULT_MODEL, AtolOpt, ModelOpt, OutOpt, PlotOpt, PresetOp
 from .stability import EXIT_NOT_FOUND, OrbitMethodOpt, _num, print_table
 
 SectionOpt = Annotated[str, typer.Option(
-    "--section", help="section surface, an expression affine in the state (parameters "
-                      "allowed), e.g. V or 'X - 0.5'")]
+    "--section", help="section surface, an expression in the state (parameters "
+                      "allowed), e.g. V, 'X - 0.5' or 'X**2 + V**2 - 4'")]
 DirectionOpt = Annotated[str, typer.Option(
     "--direction", help="crossings counted: decreasing (the surface's expression goes from "
                         "positive to negative), increasing or both")]

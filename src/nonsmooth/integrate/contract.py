@@ -52,6 +52,12 @@ MAX_GUARDS = 8
 #: evaluates it, with its gradient, by the model's ``curved(mode, k, t, c, s, u, p, mem, grad)``
 #: (``models.base.curved_row`` writes such a row); every other row is affine.
 
+#: A section surface ``H`` whose constant entry ``H[n]`` is NaN is curved: the kernel evaluates
+#: it through the ``curved`` function of ``fns`` with k = SECTION_K (h) or SECTION_K + 1 (-h,
+#: the row's other orientation), which a curved section's ``fns`` answer (see
+#: ``analysis.autonomous``); no model guard has so large an index (MAX_GUARDS).
+SECTION_K = 64
+
 
 def _quiet_first_class_functions():
     """First-class functions are "experimental" in numba, and numba warns each time it types a

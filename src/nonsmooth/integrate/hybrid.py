@@ -81,6 +81,7 @@ from .contract import (  # noqa: E402
     TANGENT_KERNEL_SIGNATURE,
     MAX_GUARDS,
     N_STATE,
+    SECTION_K,
     OPT_ATOL,
     OPT_CLOSED_FORM,
     OPT_FRAME_PERIOD,
@@ -641,11 +642,14 @@ def _curved_at(curved, mode, k, tau, C, S, hs, om, n, u, f0, u1, f1, pp, mem, gr
 
 
 @nb.njit(cache=True)
-def _immediate_exit_curved(curved, mode, tau, G, ng, n, u, f0, C, S, om, pp, mem, gr):
-    """``_immediate_exit`` for a mode with curved guards."""
+def _immediate_exit_curved(curved, mode, tau, G, ng, n, u, f0, C, S, om, pp, mem, gr, ksec,
+                           kcs):
+    """``_immediate_exit`` for a mode with curved guards (row ``ksec``: a curved section,
+    evaluated as ``curved``'s k = ``kcs``)."""
     for k in range(ng):
         if math.isnan(G[k, n]):
-            g, d = _curved_rate(curved, mode, k, tau, C, S, n, u, f0, pp, mem, gr)
+            g, d = _curved_rate(curved, mode, kcs if k == ksec else k, tau, C, S, n, u, f0, pp,
+                                mem, gr)
         else:
             g = _gval(G, k, n, u, C, S)
             d = _dgval(G, k, n, f0, C, S, om)
@@ -892,6 +896,21 @@ def _section_side(G, k, H, n, u, f, C, S, om):
     for i in range(n + 3):
         G[k, i] = sgn * H[i]
     return sgn
+
+
+@nb.njit(cache=True)
+def _section_side_curved(curved, mode, tau, G, k, H, n, u, f, C, S, pp, mem, gr):
+    """``_section_side`` of a curved section (``contract.SECTION_K``): the row is H (NaN in
+    its constant column), the orientation is returned for the caller to pass as k."""
+    for i in range(n + 3):
+        G[k, i] = H[i]
+    h, d = _curved_rate(curved, mode, SECTION_K, tau, C, S, n, u, f, pp, mem, gr)
+    scale = abs(h)
+    for i in range(n):
+        scale += abs(gr[i]) * (1.0 + abs(u[i]))
+    if abs(h) <= 1e-9 * scale:
+        return -1.0 if d < 0.0 else 1.0
+    return -1.0 if h < 0.0 else 1.0
 
 
 @nb.njit(cache=True, inline="always", fastmath=_FM)
@@ -1408,6 +1427,7 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
     # a section surface h = H . (u, 1, cos, sin) = 0 (``advance_tangent``): an extra guard row
     # whose crossings are recorded, never a transition (its sign flips at each crossing)
     has_sec = H.shape[0] > 0
+    csec = has_sec and math.isnan(H[int(opts[OPT_N])])  # a curved section (SECTION_K)
     n = int(opts[OPT_N])
     nmem = int(opts[OPT_NMEM])
     if n < 2 or nmem < 0 or n - 2 + nmem > N_STATE - ST_EXTRA:
@@ -1560,7 +1580,12 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
             keep_alive(ws)
             return st.EVENT_FAILED
         field(mode, t0, C0, S0, u, pp, mem, f0)  # (f0 is computed again below)
-        sgn = _section_side(G, ng, H, n, u, f0, C0, S0, om)
+        if csec:
+            sgn = _section_side_curved(curved, mode, t0, G, ng, H, n, u, f0, C0, S0, pp, mem,
+                                       gr)
+            ncv += 1
+        else:
+            sgn = _section_side(G, ng, H, n, u, f0, C0, S0, om)
         ksec = ng
         ng += 1
     cls = _mode_class(linear, closed, mode, pp, lin, MC, mcs, om, MF, n, MXR, PW)
@@ -1601,7 +1626,7 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
                 k_tr = _immediate_exit(G, ng, n, u, f0, C, S, om)
             else:
                 k_tr = _immediate_exit_curved(curved, mode, tau, G, ng, n, u, f0, C, S, om, pp,
-                                              mem, gr)
+                                              mem, gr, ksec, SECTION_K + (sgn < 0.0))
             if k_tr < 0:
                 if steps >= max_steps:
                     code = st.MAX_STEPS
@@ -1680,7 +1705,8 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
                     if pm or pd or curv:  # a polynomial guard (a series piece, a DOP853
                         if not curv:  # step's dense output), or a curved one
                             guard_poly(G, k, n, TW, cp)
-                        lo, hi = _guard_exit(1 if curv else 0, cp, curved, mode, k, tau, C, S,
+                        kc = SECTION_K + (sgn < 0.0) if k == ksec else k  # (curved section)
+                        lo, hi = _guard_exit(1 if curv else 0, cp, curved, mode, kc, tau, C, S,
                                              hs, om, n, u, f0, u1, f1, pp, mem, gr, us, stack,
                                              s_best, 2 if pd else (1 if pm else 0), TW)
                         if hi < 0.0:
@@ -1804,7 +1830,8 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
                                 hs_full = hs / s_best
                                 t_lo = max(s_lo - 1e-4, 0.0) * hs_full
                                 t_hi = min(s_best + 1e-4, 1.0) * hs_full
-                                gn, dn = _curved_rate(curved, mode, k_tr, tau + hs, C1, S1, n,
+                                kc = SECTION_K + (sgn < 0.0) if k_tr == ksec else k_tr
+                                gn, dn = _curved_rate(curved, mode, kc, tau + hs, C1, S1, n,
                                                       u1, f1, pp, mem, gr)
                                 for _ in range(4):
                                     if not dn < 0.0:
@@ -1817,7 +1844,7 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
                                     err2, C1, S1 = _retake(field, pm, mode, tau, C, S, hs, om, n,
                                                            u, f0, pp, mem, rtol, atol, us, k1,
                                                            k2, k3, k4, k5, u1, f1, TW, use8, K8)
-                                    g2, d2 = _curved_rate(curved, mode, k_tr, tau + hs, C1, S1,
+                                    g2, d2 = _curved_rate(curved, mode, kc, tau + hs, C1, S1,
                                                           n, u1, f1, pp, mem, gr)
                                     if not abs(g2) < abs(gn):  # no better: back, and stop
                                         hs = h_old
@@ -1929,6 +1956,8 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
                         break
                     ksec = ng
                     ng += 1
+                    if csec:
+                        ncv += 1
                 cls = _mode_class(linear, closed, mode, pp, lin, MC, mcs, om, MF, n, MXR, PW)
                 if cls == _MC_RESONANT:
                     code = st.RESONANCE
@@ -1936,8 +1965,11 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
                 cf = cls == _MC_CLOSED and ncv == 0
                 pm = cls == _MC_POLY
                 _deriv(cf, field, mode, tau, C, S, u, pp, mem, f0, MC, om)
-                if has_sec:  # the side after the reset: a jump across the surface is no
-                    sgn = _section_side(G, ksec, H, n, u, f0, C, S, om)  # crossing
+                if csec:  # the side after the reset: a jump across the surface is no
+                    sgn = _section_side_curved(curved, mode, tau, G, ksec, H, n, u, f0, C, S,
+                                               pp, mem, gr)  # crossing
+                elif has_sec:
+                    sgn = _section_side(G, ksec, H, n, u, f0, C, S, om)
                 if cf:
                     _cf_bounds(MC, mode, om, G, ng, n, GB)
                 if tan and not _saltation(transition, old_mode, k_tr, tau, C, S, om, n, ue, me,
@@ -2015,7 +2047,9 @@ def advance_tangent(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out
     crossing, and ``SEC[3]`` the time since the call began (else the time integrated). A state
     on the surface at the start (within 1e-9 of its scale: a stop on a crossing) is not a
     crossing: the side it moves to counts; a reset that jumps across the surface is not one
-    either (the side is taken again after every transition)."""
+    either (the side is taken again after every transition). A curved surface: ``H[n]`` NaN,
+    h and its gradient from ``curved(mode, contract.SECTION_K, ...)`` of ``fns`` (a curved
+    guard row)."""
     if Y.shape[0] != int(opts[OPT_N]) + len(cmi) or (qr == 1 and (
             per_period != 1 or L_out.shape[0] < n_out or L_out.shape[1] < Y.shape[1])) or (
             U_out.shape[0] > 0 and (U_out.shape[0] < n_out or U_out.shape[1] < int(opts[OPT_N]))) or (
