@@ -99,6 +99,24 @@ def test_benettin_stops_at_its_error_target_and_short_records_run_whole(monkeypa
     assert np.array_equal(short[0], stability.lambda1_points(P, solver, S, 400)[0])
 
 
+def test_evidence_runs_skip_the_extrema_and_keep_the_trajectory(monkeypatch):
+    """The lambda1 evidence's tangent runs leave out the interior extrema of X
+    (``OPT_NO_EXTREMA``, a third of their time): the same lambda1 to the last bit, on a
+    chaotic and a periodic point, through Benettin and through one monodromy pass."""
+    from nonsmooth.analysis import stability
+    from nonsmooth.kernels import Solver, new_state
+    P = np.array([ns.preset("fig4").pack(), ns.preset("table3").replace(omega=0.86).pack()])
+    solver = Solver(method="exact", model=ns.preset("fig4").model)
+    S = np.array([new_state(0.1, 0.0), new_state(0.1, 0.0)])
+    quiet = (stability.lambda1_points(P, solver, S, 300)[0],
+             stability.floquet_lambda1_points(P[1:], solver, S[1:], [3])[0])
+    monkeypatch.setattr(stability, "quiet_opts", lambda setup: setup.opts.copy())
+    full = (stability.lambda1_points(P, solver, S, 300)[0],
+            stability.floquet_lambda1_points(P[1:], solver, S[1:], [3])[0])
+    assert np.all(np.isfinite(quiet[0])) and quiet[0][0] > 0 > quiet[0][1]
+    assert np.array_equal(quiet[0], full[0]) and np.array_equal(quiet[1], full[1])
+
+
 def test_smooth_sweep_evidence_is_the_closed_form_tangent_of_the_same_equations():
     """support's ``smooth`` names ``smooth_closed_form`` (the same switch model solved
     exactly) for its lambda1 evidence: a periodic point without contact gets the linear

@@ -25,7 +25,7 @@ import xarray as xr
 
 from .. import status as st
 from ..errors import IntegrationError, ParameterError
-from ..integrate.contract import ST_H, ST_MODE
+from ..integrate.contract import OPT_NO_EXTREMA, ST_H, ST_MODE
 from ..io import apply_state_units, check_memory, provenance_attrs
 from ..kernels import mode_holds, output_buffers, run, tangent_function
 from ..models.base import KERNEL_GENERIC
@@ -454,6 +454,14 @@ def _lambda1_many(tangent, fns, P, opts, states, align, periods, N, cmi, logs, s
             Ys[i, r] = Y[r, 0]
 
 
+def quiet_opts(setup) -> np.ndarray:
+    """The tangent setup's opts for runs whose per-period outputs nobody reads (the lambda1 of
+    many points): no interior extrema of X (``OPT_NO_EXTREMA``; the trajectory is the same)."""
+    o = setup.opts.copy()
+    o[OPT_NO_EXTREMA] = 1.0
+    return o
+
+
 def generic_states(states, rows: int, reclassify: bool) -> np.ndarray:
     """A copy of kernel ``states`` (``rows`` of them) for the generic kernel: with
     ``reclassify`` (states of a specialised kernel or of another method) mode -1 and step
@@ -499,6 +507,7 @@ def lambda1_points(P, solver, states, periods: int, *, blocks: int = 10, workers
     err = np.full(n, np.nan)
     active = np.arange(n)
     align = max(20, min(periods, FIRST_STAGE) // 4)
+    opts = quiet_opts(setup)
     while active.size:
         done = int(used[active[0]])  # the active points have all run the same stages
         m = min(periods - done, FIRST_STAGE if done == 0
@@ -507,7 +516,7 @@ def lambda1_points(P, solver, states, periods: int, *, blocks: int = 10, workers
         la = np.zeros((active.size, m))
         sa = np.zeros(active.size, np.int64)
         with threads(workers), deferred_interrupts():
-            _lambda1_many(tangent_function(), setup.fns, Pa, setup.opts, Sa,
+            _lambda1_many(tangent_function(), setup.fns, Pa, opts, Sa,
                           align if done == 0 else 0, m, setup.N, setup.cmi, la, sa, Ya)
         S[active], Ys[active], status[active] = Sa, Ya, sa
         logs[active, done:done + m] = la
@@ -554,8 +563,8 @@ def floquet_lambda1_points(P, solver, states, period, *, workers=None):
     mono = np.zeros((n, setup.N, setup.N))
     status = np.zeros(n, np.int64)
     with threads(workers), deferred_interrupts():
-        _monodromy_many(tangent_function(), setup.fns, P, setup.opts, S, k, setup.N, setup.cmi,
-                        mono, status)
+        _monodromy_many(tangent_function(), setup.fns, P, quiet_opts(setup), S, k, setup.N,
+                        setup.cmi, mono, status)
     lam = np.full(n, np.nan)
     om = solver.model.frequency(P)
     T = 2.0 * np.pi / om

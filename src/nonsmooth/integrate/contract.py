@@ -34,7 +34,9 @@ OPT_CLOSED_FORM = 7  # 1: propagate the modes a model declares linear in closed 
 OPT_PHASE = 8  # forcing phase psi = omega t_s of the section (generic): periods start at t_s
 OPT_FRAME_PERIOD = 9  # 1: p[opts[OPT_OMEGA]] is the forcing period T, omega = 2 pi / T
 OPT_NO_DOP853 = 10  # 1: the RKF45 even below rk8.HI_ORDER_RTOL (Method.dop853 False; generic)
-N_OPTS = 11
+OPT_NO_EXTREMA = 11  # 1: no interior extrema of X (Xmax/Xmin outputs: the ends of the steps
+#                      only; generic): a tangent run whose outputs nobody reads (lambda1 evidence)
+N_OPTS = 12
 
 # state layout
 ST_X = 0

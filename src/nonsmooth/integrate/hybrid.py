@@ -89,6 +89,7 @@ from .contract import (  # noqa: E402
     OPT_N,
     OPT_NMEM,
     OPT_NO_DOP853,
+    OPT_NO_EXTREMA,
     OPT_PHASE,
     OPT_OMEGA,
     OPT_RTOL,
@@ -1530,6 +1531,7 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
     closed = opts[OPT_CLOSED_FORM] == 1.0
     # a tight tolerance integrates by DOP853 (``rk8``), its tangent too, unless the method says
     use8 = rtol < HI_ORDER_RTOL and opts[OPT_NO_DOP853] != 1.0
+    no_ext = opts.shape[0] > OPT_NO_EXTREMA and opts[OPT_NO_EXTREMA] == 1.0
     om4 = (om * om) * (om * om)
     for q in range(len(cmi)):
         if cmi[q] < 0 or cmi[q] >= nmem:
@@ -1879,7 +1881,9 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
                     else:
                         h = _control(max(err2, errY2), hs, h, last, rejected)
                     rejected = False
-                if cf:
+                if no_ext:
+                    pass  # (OPT_NO_EXTREMA: the outputs are not read)
+                elif cf:
                     xmax, xmin = _x_extrema_exact(MC, mode, om, MF[mode], y0, z0, C, S, u[0],
                                                   u[1], u1[0], u1[1], hs, xmax, xmin)
                 elif pm:
