@@ -507,7 +507,8 @@ def limit_cycle(params, section="V", *, x0: float = 0.0, v0: float = 0.0, u0=Non
                 max_time: float = 1e4, samples: int = 400, crossings: int = 1) -> xr.Dataset:
     """A limit cycle of a self-excited system, stable or unstable, with its period, by Newton
     shooting on ``section`` (see the module docstring) from the ``transient``-th crossing of
-    the trajectory from (x0, v0) (or ``u0``): a fixed point of the ``crossings``-th return
+    the trajectory from (x0, v0) (or ``u0``; ``transient`` >= 1: Newton starts on the
+    section): a fixed point of the ``crossings``-th return
     (a cycle that crosses the section that many times per turn, e.g. both ways).
 
     Returns a Dataset: ``period``, the section point (``X_section``, ``V_section``, ...), the
