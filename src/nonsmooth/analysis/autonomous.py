@@ -146,8 +146,8 @@ class Surface:
         return np.linalg.svd(a[None, :])[2][1:].T
 
     def project(self, z, a, p, iters: int = 8):
-        """z moved along the direction ``a`` onto the surface (Newton on h; z itself for an
-        affine surface whose row is ``a``, or when Newton does not converge)."""
+        """z moved along the direction ``a`` onto the surface: Newton on h(z + s a) = 0 (at
+        most ``iters`` steps; an affine surface in one)."""
         z = np.array(z, float)
         if not self.curved:
             return z - (self.value(z, p) / float(a @ a)) * a

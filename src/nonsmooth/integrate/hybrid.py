@@ -901,8 +901,10 @@ def _section_side(G, k, H, n, u, f, C, S, om):
 
 @nb.njit(cache=True)
 def _section_side_curved(curved, mode, tau, G, k, H, n, u, f, C, S, pp, mem, gr):
-    """``_section_side`` of a curved section (``contract.SECTION_K``): the row is H (NaN in
-    its constant column), the orientation is returned for the caller to pass as k."""
+    """``_section_side`` of a curved section: writes the row H (NaN in its constant column)
+    to G[k] and returns the orientation sgn (+1 where h >= 0 on the state's side, or on the
+    side it moves to from the surface), which the caller passes to ``curved`` as k =
+    ``contract.SECTION_K`` + (sgn < 0)."""
     for i in range(n + 3):
         G[k, i] = H[i]
     h, d = _curved_rate(curved, mode, SECTION_K, tau, C, S, n, u, f, pp, mem, gr)
