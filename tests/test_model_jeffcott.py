@@ -171,6 +171,72 @@ def test_a_wrong_curved_guard_or_linear_mode_is_one_line():
         assert needle in str(exc.value) and "\n" not in str(exc.value)
 
 
+def test_smooth_modes_are_labels_switched_at_step_ends():
+    """The smooth method's modes only name the side of the circle (one field, no reset):
+    label surfaces, whose crossing the kernel does not locate (``contract``). The trajectory
+    is then bit for bit that of the same field written as one mode, and at every output (a
+    step's end) the mode is the side of the circle the state is on."""
+    from nonsmooth.models import jeffcott_rotor as J
+    one = ns.model_from_equations(
+        "jeffcott_one_mode", states=("X", "V", "Y", "W"),
+        parameters={q.name: q for q in J.PARAMETERS}, forcing_amplitude="e",
+        methods={"smooth": dict(modes={"free": [
+            "V", f"{J.FREE_X} - {J.SMOOTH_PRESS}*(X - mu*Y)",
+            "W", f"{J.FREE_Y} - {J.SMOOTH_PRESS}*(mu*X + Y)"]})})
+    p = ROTOR.preset("partial_rub")
+    ds = ns.simulate(p, periods=30, samples_per_period=16, method="smooth")
+    ref = ns.simulate(one.params(**{q: getattr(p, q) for q in ROTOR.param_names}), periods=30,
+                      samples_per_period=16, method="smooth")
+    U = ns.io.components(ds).values
+    assert np.array_equal(U, ns.io.components(ref).values)
+    r = np.hypot(U[:, 0], U[:, 2])
+    rub = ds.region.values == ROTOR.mode_names.index("rub")
+    assert rub.any() and (~rub).any()
+    assert np.array_equal(rub[1:], r[1:] > p.delta)  # (the start: classified by initial)
+
+
+def test_a_label_surface_between_different_fields_is_one_line():
+    from nonsmooth.models import Method, Model, Param
+    from nonsmooth.models.oscillator import label_row
+
+    def field(mode, t, c, s, u, p, mem, du):
+        du[0] = u[1]
+        du[1] = -u[0] - mode * u[1] + p[0] * c  # mode 1 is damped: another field
+        return 0
+
+    def jacobian(mode, t, c, s, u, p, mem, J):
+        J[0, 0] = 0.0
+        J[0, 1] = 1.0
+        J[1, 0] = -1.0
+        J[1, 1] = -1.0 * mode
+        return 0
+
+    def guards(mode, p, mem, G):
+        label_row(G, 0)
+        return 1
+
+    def transition(mode, k, t, c, s, u, p, mem):
+        return 1 - mode
+
+    def initial(c, s, u, p, mem):
+        return 0
+
+    def curved(mode, k, t, c, s, u, p, mem, grad):
+        sg = 1.0 - 2.0 * mode
+        grad[0] = -2.0 * sg * u[0]
+        grad[1] = -2.0 * sg * u[1]
+        grad[2] = 0.0
+        return sg * (1.0 - u[0] * u[0] - u[1] * u[1])
+
+    params = (Param("F0", 0.5), Param("omega", 1.0, low=0.0, low_open=True))
+    m = Model("disc_label", "a disc", params, ("X", "V"), ("inside", "outside"),
+              {"smooth": Method(field, jacobian, guards, transition, initial, curved=curved)})
+    with pytest.raises(ParameterError) as exc:
+        m.fns("smooth")
+    assert "smooth.guards marks surface 0 of mode inside a label, but the mode it enters " \
+           "(outside) has another field" in str(exc.value) and "\n" not in str(exc.value)
+
+
 def test_impacts_on_a_circle_floquet_multipliers_equal_finite_differences():
     """A mass in a circular clearance (centre (-2, 0), radius 3: the wall it hits is near
     X = 1) with Newton's law on the normal velocity, written as equations (a curved guard and a

@@ -54,6 +54,12 @@ MAX_GUARDS = 8
 #: evaluates it, with its gradient, by the model's ``curved(mode, k, t, c, s, u, p, mem, grad)``
 #: (``models.base.curved_row`` writes such a row); every other row is affine.
 
+#: A curved row with G[k, n + 1] = 1 is a *label* (``models.oscillator.label_row``): the mode
+#: on its other side has the same field and the transition resets nothing (a smoothed method's
+#: modes that only name the side of a surface). The kernel does not locate its crossing: it
+#: switches the mode at the end of the first step that ends on the other side (no tangent
+#: saltation, which would be the identity).
+
 #: A section surface ``H`` whose constant entry ``H[n]`` is NaN is curved: the kernel evaluates
 #: it through the ``curved`` function of ``fns`` with k = SECTION_K (h) or SECTION_K + 1 (-h,
 #: the row's other orientation), which a curved section's ``fns`` answer (see

@@ -33,7 +33,10 @@ Design summary
   found; the crossing is located by Illinois on the true g (on a series piece, whose guard is a
   polynomial, by Newton: ``linmodes.poly_root``). Its gradient enters the saltation
   matrix. A mode with a curved guard is never taken in the oscillator's closed form (the
-  series of ``linmodes`` evaluates curved guards on its exact polynomial).
+  series of ``linmodes`` evaluates curved guards on its exact polynomial). A curved *label*
+  (G[k, n+1] = 1, ``models.oscillator.label_row``: the same field across it, no reset) is not
+  located: the mode switches at the end of the first step that ends past it, so that the
+  region at every output is the side the state is on, at no cost to the steps.
 * A guard with forcing terms (G[k, n+1], G[k, n+2]) is not a cubic along a step, and a step can
   be long (a stick phase has a zero error estimate, so its RKF45 steps grow to a whole output
   interval): its exit test is certified, and so is every guard on a closed-form piece (the
@@ -1706,6 +1709,14 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
                 En = -1.0  # energy norm of a closed-form piece, when needed
                 for k in range(ng):
                     curv = ncv > 0 and math.isnan(G[k, n])
+                    if curv and G[k, n + 1] == 1.0 and k != ksec:
+                        # a label (``contract``): its sign at the step's end, not located
+                        if curved(mode, k, tau + hs, C1, S1, u1, pp, mem, gr) < 0.0 \
+                                and 1.0 < s_best:
+                            s_best = 1.0
+                            s_lo = 1.0
+                            k_tr = k
+                        continue
                     if pm or pd or curv:  # a polynomial guard (a series piece, a DOP853
                         if not curv:  # step's dense output), or a curved one
                             guard_poly(G, k, n, TW, cp)
@@ -1874,7 +1885,10 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
                         errY2 = _rk_tangent(jacobian, mode, tau, C, S, hs, om, n, u, f0, k1, k2,
                                             k3, k4, k5, pp, mem, Y, W, KY, J, JS, us, cmi,
                                             rtol, atol)
-                if k_tr < 0 and not cf and not pm:
+                # (a label's switch at the step's end leaves the step whole: it is controlled)
+                lab_end = k_tr >= 0 and ncv > 0 and math.isnan(G[k_tr, n]) \
+                    and G[k_tr, n + 1] == 1.0 and k_tr != ksec
+                if (k_tr < 0 or lab_end) and not cf and not pm:
                     # step-size control after an accepted step without a switch; with tangent
                     # vectors, also by their error (at rest the state's estimate is 0, and a
                     # step of a whole period would give the tangent of the RK polynomial)
@@ -1926,7 +1940,8 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
                 # ---- transition through guard k_tr at (tau, u) ----
                 gdot = 0.0
                 old_mode = mode
-                if tan:
+                label = ncv > 0 and math.isnan(G[k_tr, n]) and G[k_tr, n + 1] == 1.0
+                if tan and not label:
                     for i in range(n):
                         ue[i] = u[i]
                         fm[i] = f0[i]
@@ -1978,9 +1993,9 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
                     sgn = _section_side(G, ksec, H, n, u, f0, C, S, om)
                 if cf:
                     _cf_bounds(MC, mode, om, G, ng, n, GB)
-                if tan and not _saltation(transition, old_mode, k_tr, tau, C, S, om, n, ue, me,
-                                          fm, gk, gdot, mode, u, mem, f0, pp, Y, cmi, uc, mc,
-                                          ua, ma, n_tiny > 0, tw_last):
+                if tan and not label and not _saltation(
+                        transition, old_mode, k_tr, tau, C, S, om, n, ue, me, fm, gk, gdot,
+                        mode, u, mem, f0, pp, Y, cmi, uc, mc, ua, ma, n_tiny > 0, tw_last):
                     code = st.GRAZING
                     break
                 if not _finite(u, n):

@@ -53,7 +53,11 @@ signatures of :mod:`nonsmooth.integrate.contract`). It declares
       are located on the step's interpolant like affine ones, grazing dips included (the
       true g is evaluated at the interpolant's critical points), and their gradient enters
       the saltation matrix; a mode with a curved guard is not taken in the oscillator's closed
-      form (a general linear mode, kind 2 of ``linear``, is).
+      form (a general linear mode, kind 2 of ``linear``, is). ``label_row(G, k)`` marks a
+      curved surface a *label*: the mode across it has the same field and the transition
+      resets nothing (a smoothed method's modes that only name a side); the kernel then
+      switches the mode at the first step end past it instead of locating the crossing
+      (checked at the sample point; ``model_from_equations`` marks such surfaces itself).
   ``linear(mode, p, out) -> 0, 1 or 2`` (optional)
       1 (n = 2) if the mode is X'' + c X' + k X = F cos(omega t) + b with k > 0, c >= 0 (out[0:4] =
       k, c, b, F); 2 (any n, any stiffness) if it is u' = A u + b + f_c cos(omega t) +
@@ -613,10 +617,19 @@ def _sample_check(model, method, m, fns, max_guards):
         for k in range(ng):
             if math.isnan(G[k, n]):
                 _check_curved(model, m, fns, mode, k, p, u, mem, bad, call_curved)
-            new = int(call_transition(fns, mode, k, t, c, s, u.copy(), p, mem.copy()))
+            uk, mk = u.copy(), mem.copy()
+            new = int(call_transition(fns, mode, k, t, c, s, uk, p, mk))
             if not 0 <= new < len(model.mode_names):
                 raise bad(f"transition from mode {name} through surface {k} goes to unknown "
                           f"mode {new} (modes: 0..{len(model.mode_names) - 1})")
+            if math.isnan(G[k, n]) and G[k, n + 1] == 1.0:  # a label (``label_row``)
+                du2 = np.zeros(n)
+                call_field(fns, new, t, c, s, u, p, mem, du2)
+                if not (np.array_equal(uk, u) and np.array_equal(mk, mem)
+                        and np.allclose(du2, du, rtol=1e-12, atol=1e-12)):
+                    raise bad(f"guards marks surface {k} of mode {name} a label, but the "
+                              f"mode it enters ({model.mode_names[new]}) has another field or "
+                              f"the transition resets the state")
 
 
 def _check_linear(model, fns, mode, p, u, mem, t, c, s, du, bad, call_linear):

@@ -349,9 +349,15 @@ def _derive(sp, ctx, name, mname, spec, states, pnames, mode_names, closed_form,
     linear = {m: v for m, v in linear.items() if v[1] is not None}
     text = spec.get("admissible")
     cond = _admissible(ctx, text, bad) if text is not None else None
+    # labels (``integrate.contract``): a curved surface whose one branch enters a mode of the
+    # same field without a reset, e.g. a smoothed method's modes that only name a side
+    labels = {(m, j) for m, brs in branches.items() for j, br in enumerate(brs)
+              if not isinstance(rows[m][j], list) and len(br) == 1 and br[0][0] is sp.true
+              and not br[0][2] and all(sp.simplify(a - b) == 0 for a, b in zip(
+                  fields[m], fields[mode_names[br[0][1]]]))}
     try:
         source = _source(sp, ctx, states, pnames, mode_names, own, fields, rows, branches,
-                         init, linear, cond, cm)
+                         init, linear, cond, cm, labels)
     except Exception as exc:  # noqa: BLE001 - an expression SymPy cannot print as Python
         raise bad(f"method {mname}: cannot generate its functions "
                   f"({type(exc).__name__}: {str(exc).splitlines()[0] if str(exc) else ''})"
@@ -701,7 +707,7 @@ class _Context:
 
 
 def _source(sp, ctx, states, pnames, mode_names, own, fields, rows, branches, init,
-            linear, admissible=None, cm=()) -> str:
+            linear, admissible=None, cm=(), labels=frozenset()) -> str:
     """The Python source of the seven model functions, and of ``admissible(u, p)`` (plain
     Python) where the method has that condition."""
     from sympy.printing.precedence import PRECEDENCE
@@ -812,9 +818,11 @@ def _source(sp, ctx, states, pnames, mode_names, own, fields, rows, branches, in
             cols = list(range(n)) + [n, n + 1, n + 2]
             if isinstance(row, list):
                 out += [f"G[{k}, {col}] = float({code(v)})" for col, v in zip(cols, row)]
-            else:  # curved (``models.oscillator.curved_row``)
+            else:  # curved (``models.oscillator.curved_row``; ``label_row``)
                 out += [f"G[{k}, {col}] = 0.0" for col in cols if col != n]
                 out += [f"G[{k}, {n}] = math.nan"]
+                if (m, k) in labels:
+                    out += [f"G[{k}, {n + 1}] = 1.0"]
         return out + [f"return {len(rows.get(m, ()))}"] if out else []
 
     src += ["", "", "def guards(mode, p, mem, G):", *unpack_p, *unpack_m]

@@ -31,3 +31,12 @@ def curved_row(G, k):
     for i in range(G.shape[1]):
         G[k, i] = 0.0
     G[k, n] = math.nan
+
+
+@nb.njit(cache=True, inline="always")
+def label_row(G, k):
+    """Surface k is curved and a *label* (``integrate.contract``): the mode across it has the
+    same field and the transition resets nothing, so the kernel switches the mode at the end
+    of the first step past it instead of locating the crossing."""
+    curved_row(G, k)
+    G[k, G.shape[1] - 2] = 1.0
