@@ -652,6 +652,8 @@ def _immediate_exit_curved(curved, mode, tau, G, ng, n, u, f0, C, S, om, pp, mem
     evaluated as ``curved``'s k = ``kcs``)."""
     for k in range(ng):
         if math.isnan(G[k, n]):
+            if G[k, n + 1] == 1.0 and k != ksec:
+                continue  # a label: switched at a step's end (``contract``)
             g, d = _curved_rate(curved, mode, kcs if k == ksec else k, tau, C, S, n, u, f0, pp,
                                 mem, gr)
         else:
