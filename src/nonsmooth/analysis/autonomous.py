@@ -84,9 +84,9 @@ def parse_section(params, section):
                              f"(state: {', '.join(model.state_names)}; parameters allowed)")
     try:
         expr = sp.sympify(section, locals=names)
-    except (sp.SympifyError, SyntaxError, TypeError) as exc:
-        raise ParameterError(f"section: cannot read {section!r} "
-                             f"({type(exc).__name__})") from None
+    except (sp.SympifyError, SyntaxError, TypeError):
+        raise ParameterError(f"section: cannot read {section!r}: not an expression in the "
+                             f"state ({', '.join(model.state_names)}) and the parameters") from None
     unknown = {str(s) for s in expr.free_symbols} - set(names)
     if unknown:
         raise ParameterError(f"section: unknown name(s) {', '.join(sorted(unknown))} in "

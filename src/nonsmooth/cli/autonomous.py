@@ -65,12 +65,14 @@ def limit_cycle_cmd(
     a = ds.attrs
     if a["status"] != "converged":
         typer.echo(f"error: limit-cycle: no cycle found on {a['section']}: {a['status']} "
-                   f"(after {a['iterations']} iterations); try another start (--x0, --v0, "
+                   f"(after {a['iterations']} iteration{'' if a['iterations'] == 1 else 's'}); "
+                   f"try another start (--x0, --v0, "
                    f"--u0), section or --transient", err=True)
         raise typer.Exit(EXIT_NOT_FOUND)
     save_outputs(ds, preset, out, None)
     typer.echo(f"{preset} ({method}): limit cycle on {a['section']}, period "
-               f"{float(ds.period):.10g}, converged in {a['iterations']} iterations "
+               f"{float(ds.period):.10g}, converged in {a['iterations']} "
+               f"iteration{'' if a['iterations'] == 1 else 's'} "
                f"(residual {a['residual']:.3g})")
     names = params.model.state_names
     print_table(names, [tuple(_num(float(x)) for x in

@@ -157,7 +157,7 @@ def orbit_cmd(
     from ..plot.stability import multiplier_value, plot_orbit
     save_outputs(ds, preset, out, plot, lambda d: plot_orbit(d, show=pair))
     typer.echo(f"{preset} ({method}): period-{k} orbit converged in {a['iterations']} "
-               f"iterations (residual {a['residual']:.3g})")
+               f"iteration{'' if a['iterations'] == 1 else 's'} (residual {a['residual']:.3g})")
     print_table(("point",) + tuple(f"{nm}(jT)" for nm in params.model.state_names),
                 [(str(j),) + tuple(_num(float(x))
                                    for x in components(ds, suffix="_section").values[j])
