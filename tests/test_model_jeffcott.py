@@ -195,6 +195,23 @@ def test_smooth_modes_are_labels_switched_at_step_ends():
     assert np.array_equal(rub[1:], r[1:] > p.delta)  # (the start: classified by initial)
 
 
+def test_a_surface_is_no_label_where_the_mode_across_watches_another():
+    """Two modes of one field, switched across a curved surface without a reset, but the mode
+    across also watches a wall: the surface is located as any curved guard (a label's switch at
+    a step's end would leave the wall unwatched over the rest of that step), so the wall stops
+    the mass whatever the output sampling."""
+    m = ns.model_from_equations(
+        "label_and_wall", states=("X", "V"), parameters={"k": 1.0},
+        modes={"a": ["exp(V)*k", "0"], "b": ["exp(V)*k", "0"], "c": ["0", "0"]},
+        guards={"a": [("-X - X**3", "b")], "b": [("X + X**3", "a"), ("0.5 - X", "c")]},
+        initial=[("X < 0", "a")], omega=None)
+    for spp in (1, 4):
+        ds = ns.simulate(m.params(), periods=2, samples_per_period=spp, x0=-3.0,
+                         method="exact")
+        assert float(ds.X[-1]) == pytest.approx(0.5, abs=1e-12)
+        assert int(ds.region[-1]) == m.mode_names.index("c")
+
+
 def test_a_label_surface_between_different_fields_is_one_line():
     from nonsmooth.models import Method, Model, Param
     from nonsmooth.models.oscillator import label_row

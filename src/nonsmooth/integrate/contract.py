@@ -55,10 +55,12 @@ MAX_GUARDS = 8
 #: (``models.base.curved_row`` writes such a row); every other row is affine.
 
 #: A curved row with G[k, n + 1] = 1 is a *label* (``models.oscillator.label_row``): the mode
-#: on its other side has the same field and the transition resets nothing (a smoothed method's
-#: modes that only name the side of a surface). The kernel does not locate its crossing: it
-#: switches the mode at the end of the first step that ends on the other side (no tangent
-#: saltation, which would be the identity).
+#: on its other side has the same field, the transition resets nothing, and it is the only
+#: surface of both modes (a smoothed method's modes that only name the side of a surface). The
+#: kernel does not locate its crossing: it switches the mode at the end of the first step that
+#: ends on the other side (no tangent saltation, which would be the identity); a pass and
+#: return inside a step that the Hermite of (g, g') at its ends shows adds the mode across to
+#: the visited mask (one shorter than that, a graze of a step's size, is not seen).
 
 #: A section surface ``H`` whose constant entry ``H[n]`` is NaN is curved: the kernel evaluates
 #: it through the ``curved`` function of ``fns`` with k = SECTION_K (h) or SECTION_K + 1 (-h,

@@ -36,7 +36,9 @@ Design summary
   series of ``linmodes`` evaluates curved guards on its exact polynomial). A curved *label*
   (G[k, n+1] = 1, ``models.oscillator.label_row``: the same field across it, no reset) is not
   located: the mode switches at the end of the first step that ends past it, so that the
-  region at every output is the side the state is on, at no cost to the steps.
+  region at every output is the side the state is on, at no cost to the steps; a pass and
+  return inside a step that the Hermite of (g, g') at its ends shows marks the mode across as
+  visited.
 * A guard with forcing terms (G[k, n+1], G[k, n+2]) is not a cubic along a step, and a step can
   be long (a stick phase has a zero error estimate, so its RKF45 steps grow to a whole output
   interval): its exit test is certified, and so is every guard on a closed-form piece (the
@@ -1709,15 +1711,32 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
                 s_best = 2.0
                 s_lo = 0.0  # the located crossing lies in [s_lo, s_best] (fractions)
                 En = -1.0  # energy norm of a closed-form piece, when needed
+                dip_k = -1  # a label passed and re-crossed inside the step (its fraction)
+                dip_s = 2.0
                 for k in range(ng):
                     curv = ncv > 0 and math.isnan(G[k, n])
                     if curv and G[k, n + 1] == 1.0 and k != ksec:
-                        # a label (``contract``): its sign at the step's end, not located
-                        if curved(mode, k, tau + hs, C1, S1, u1, pp, mem, gr) < 0.0 \
-                                and 1.0 < s_best:
-                            s_best = 1.0
-                            s_lo = 1.0
-                            k_tr = k
+                        # a label (``contract``): the mode switches at the step's end if it
+                        # ends past it; a pass and return inside the step that the Hermite of
+                        # (g, g') at the step's ends shows is only a visit of the mode across
+                        # (the visited mask), not a switch
+                        g1, d1 = _curved_rate(curved, mode, k, tau + hs, C1, S1, n, u1, f1, pp,
+                                              mem, gr)
+                        if g1 < 0.0:
+                            if 1.0 < s_best:
+                                s_best = 1.0
+                                s_lo = 1.0
+                                k_tr = k
+                        else:
+                            g0, d0 = _curved_rate(curved, mode, k, tau, C, S, n, u, f0, pp, mem,
+                                                  gr)
+                            b1, b2, b3 = herm_coeffs(max(g0, 0.0), d0, g1, d1, hs)
+                            r1, r2 = quad_roots01(b1, 2.0 * b2, 3.0 * b3)
+                            for q in (r1, r2):
+                                if 0.0 < q < min(dip_s, 1.0) and 2.0 * b2 + 6.0 * b3 * q > 0.0 \
+                                        and max(g0, 0.0) + q * (b1 + q * (b2 + q * b3)) < 0.0:
+                                    dip_s = q
+                                    dip_k = k
                         continue
                     if pm or pd or curv:  # a polynomial guard (a series piece, a DOP853
                         if not curv:  # step's dense output), or a curved one
@@ -1828,6 +1847,13 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
                         k_tr = k
                 if code != st.OK:
                     break
+                if dip_k >= 0 and dip_s < s_best:  # the mode across the label: visited
+                    for i in range(n):
+                        us[i] = u1[i]  # (a label resets nothing: a copy for the call)
+                    Cd, Sd = _rotate(C, S, om * (dip_s * hs))
+                    dm = transition(mode, dip_k, tau + dip_s * hs, Cd, Sd, us, pp, mem)
+                    if 0 <= dm < MAX_MODES:
+                        mask |= 1 << dm
 
                 if k_tr >= 0:
                     if s_best < 1.0:  # retake the step exactly up to the crossing

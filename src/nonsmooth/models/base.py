@@ -54,8 +54,9 @@ signatures of :mod:`nonsmooth.integrate.contract`). It declares
       true g is evaluated at the interpolant's critical points), and their gradient enters
       the saltation matrix; a mode with a curved guard is not taken in the oscillator's closed
       form (a general linear mode, kind 2 of ``linear``, is). ``label_row(G, k)`` marks a
-      curved surface a *label*: the mode across it has the same field and the transition
-      resets nothing (a smoothed method's modes that only name a side); the kernel then
+      curved surface a *label*: the mode across it has the same field, the transition
+      resets nothing and it is the only surface of both modes (a smoothed method's modes
+      that only name a side); the kernel then
       switches the mode at the first step end past it instead of locating the crossing
       (checked at the sample point; ``model_from_equations`` marks such surfaces itself).
   ``linear(mode, p, out) -> 0, 1 or 2`` (optional)
@@ -630,6 +631,13 @@ def _sample_check(model, method, m, fns, max_guards):
                     raise bad(f"guards marks surface {k} of mode {name} a label, but the "
                               f"mode it enters ({model.mode_names[new]}) has another field or "
                               f"the transition resets the state")
+                G2 = np.zeros_like(G)
+                ng2 = int(call_guards(fns, new, p, mem, G2))
+                if ng != 1 or ng2 != 1 or not (math.isnan(G2[0, n]) and G2[0, n + 1] == 1.0):
+                    raise bad(f"guards marks surface {k} of mode {name} a label, but a label "
+                              f"must be the only surface of both modes it separates (the "
+                              f"kernel does not look for another surface up to the step's "
+                              f"end)")
 
 
 def _check_linear(model, fns, mode, p, u, mem, t, c, s, du, bad, call_linear):

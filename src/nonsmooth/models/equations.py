@@ -349,12 +349,21 @@ def _derive(sp, ctx, name, mname, spec, states, pnames, mode_names, closed_form,
     linear = {m: v for m, v in linear.items() if v[1] is not None}
     text = spec.get("admissible")
     cond = _admissible(ctx, text, bad) if text is not None else None
-    # labels (``integrate.contract``): a curved surface whose one branch enters a mode of the
-    # same field without a reset, e.g. a smoothed method's modes that only name a side
-    labels = {(m, j) for m, brs in branches.items() for j, br in enumerate(brs)
-              if not isinstance(rows[m][j], list) and len(br) == 1 and br[0][0] is sp.true
-              and not br[0][2] and all(sp.simplify(a - b) == 0 for a, b in zip(
-                  fields[m], fields[mode_names[br[0][1]]]))}
+    # labels (``integrate.contract``): two modes of the same field that watch one curved
+    # surface each, into each other, without a reset (a smoothed method's modes that only
+    # name a side): nothing else can happen in either, so the crossing need not be located
+    def pure(m):
+        brs = branches.get(m, ())
+        return len(brs) == 1 and not isinstance(rows[m][0], list) and len(brs[0]) == 1 \
+            and brs[0][0][0] is sp.true and not brs[0][0][2]
+
+    labels = set()
+    for m in own:
+        if pure(m):
+            t = mode_names[branches[m][0][0][1]]
+            if t != m and pure(t) and mode_names[branches[t][0][0][1]] == m and all(
+                    sp.simplify(a - b) == 0 for a, b in zip(fields[m], fields[t])):
+                labels.add((m, 0))
     try:
         source = _source(sp, ctx, states, pnames, mode_names, own, fields, rows, branches,
                          init, linear, cond, cm, labels)

@@ -36,7 +36,8 @@ def curved_row(G, k):
 @nb.njit(cache=True, inline="always")
 def label_row(G, k):
     """Surface k is curved and a *label* (``integrate.contract``): the mode across it has the
-    same field and the transition resets nothing, so the kernel switches the mode at the end
-    of the first step past it instead of locating the crossing."""
+    same field, the transition resets nothing, and it is the only surface of both modes, so
+    the kernel switches the mode at the end of the first step past it instead of locating the
+    crossing."""
     curved_row(G, k)
     G[k, G.shape[1] - 2] = 1.0
