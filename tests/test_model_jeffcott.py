@@ -253,6 +253,34 @@ def test_a_label_surface_between_different_fields_is_one_line():
     assert "smooth.guards marks surface 0 of mode inside a label, but the mode it enters " \
            "(outside) has another field" in str(exc.value) and "\n" not in str(exc.value)
 
+    def field_same(mode, t, c, s, u, p, mem, du):
+        du[0] = u[1]
+        du[1] = -u[0] + p[0] * c
+        return 0
+
+    def jacobian_same(mode, t, c, s, u, p, mem, J):
+        J[0, 0] = 0.0
+        J[0, 1] = 1.0
+        J[1, 0] = -1.0
+        J[1, 1] = 0.0
+        return 0
+
+    def guards_wall(mode, p, mem, G):  # the label, and a wall X <= 2 beside it
+        label_row(G, 0)
+        for i in range(5):
+            G[1, i] = 0.0
+        G[1, 0] = -1.0
+        G[1, 2] = 2.0
+        return 2
+
+    m = Model("disc_label_wall", "a disc", params, ("X", "V"), ("inside", "outside"),
+              {"smooth": Method(field_same, jacobian_same, guards_wall, transition, initial,
+                                curved=curved)})
+    with pytest.raises(ParameterError) as exc:
+        m.fns("smooth")
+    assert "a label must be the only surface of both modes it separates" in str(exc.value)
+    assert "\n" not in str(exc.value)
+
 
 def test_impacts_on_a_circle_floquet_multipliers_equal_finite_differences():
     """A mass in a circular clearance (centre (-2, 0), radius 3: the wall it hits is near
