@@ -116,21 +116,26 @@ def test_intermittent_rub_against_scipy_with_events():
     assert not np.all(ds.visited.values == 0b10)  # and free flight
 
 
+def _disc_field(mode, t, c, s, u, p, mem, du):
+    """A forced undamped oscillator (the hand-written models of the refusal tests)."""
+    du[0] = u[1]
+    du[1] = -u[0] + p[0] * c
+    return 0
+
+
+def _disc_jacobian(mode, t, c, s, u, p, mem, J):
+    J[0, 0] = 0.0
+    J[0, 1] = 1.0
+    J[1, 0] = -1.0
+    J[1, 1] = 0.0
+    return 0
+
+
 def test_a_wrong_curved_guard_or_linear_mode_is_one_line():
     from nonsmooth.models import Method, Model, Param
     from nonsmooth.models.oscillator import curved_row
 
-    def field(mode, t, c, s, u, p, mem, du):
-        du[0] = u[1]
-        du[1] = -u[0] + p[0] * c
-        return 0
-
-    def jacobian(mode, t, c, s, u, p, mem, J):
-        J[0, 0] = 0.0
-        J[0, 1] = 1.0
-        J[1, 0] = -1.0
-        J[1, 1] = 0.0
-        return 0
+    field, jacobian = _disc_field, _disc_jacobian
 
     def guards(mode, p, mem, G):
         curved_row(G, 0)
@@ -253,17 +258,6 @@ def test_a_label_surface_between_different_fields_is_one_line():
     assert "smooth.guards marks surface 0 of mode inside a label, but the mode it enters " \
            "(outside) has another field" in str(exc.value) and "\n" not in str(exc.value)
 
-    def field_same(mode, t, c, s, u, p, mem, du):
-        du[0] = u[1]
-        du[1] = -u[0] + p[0] * c
-        return 0
-
-    def jacobian_same(mode, t, c, s, u, p, mem, J):
-        J[0, 0] = 0.0
-        J[0, 1] = 1.0
-        J[1, 0] = -1.0
-        J[1, 1] = 0.0
-        return 0
 
     def guards_wall(mode, p, mem, G):  # the label, and a wall X <= 2 beside it
         label_row(G, 0)
@@ -274,7 +268,7 @@ def test_a_label_surface_between_different_fields_is_one_line():
         return 2
 
     m = Model("disc_label_wall", "a disc", params, ("X", "V"), ("inside", "outside"),
-              {"smooth": Method(field_same, jacobian_same, guards_wall, transition, initial,
+              {"smooth": Method(_disc_field, _disc_jacobian, guards_wall, transition, initial,
                                 curved=curved)})
     with pytest.raises(ParameterError) as exc:
         m.fns("smooth")
