@@ -15,6 +15,11 @@ intervals), never a number of the results.
   kernel's event tolerance: an affine h = a . u + b as an affine row; any other as a curved
   guard (:class:`Surface`: h and its gradient a(u), derived by SymPy, compiled into the
   ``curved`` function of the flow's ``fns``, ``contract.SECTION_K``).
+* **A forced system** (``surface_section``, ``surface_bifurcation_diagram``): its crossings
+  of a surface come with the forcing phase omega t mod 2 pi (``phase``); the runs go over
+  whole forcing periods from a period's start (``_Flow.record``). A section on a switching
+  surface itself counts the switching event as the crossing, with the state before the
+  transition (the kernel's ``_section_hit``): the impact map (phase, velocity before impact).
 * **Return map** P: a point z on the section to the next crossing in the direction; its time is
   the return time. Its Jacobian from the flow's tangent Phi (saltation matrices at the
   switches included) and the field f at the crossing: dP = (I - f a^T / (a . f)) Phi, a the
@@ -213,6 +218,12 @@ def _section_cfunc(curved_expr, model, base):
     return nb.cfunc(MODEL_SIGNATURES[6], error_model="numpy")(ns_["curved"])
 
 
+def is_forced(params) -> bool:
+    """The model's forcing amplitude is not 0 (a model that names none is unforced)."""
+    fa = params.model.forcing_amplitude
+    return bool(fa and fa in params.model.param_names and float(getattr(params, fa)) != 0.0)
+
+
 def check_autonomous(params, who: str, solver=None) -> None:
     """A one-line ParameterError if the model's forcing amplitude is not 0 (a model that
     names none is taken as unforced), or, with ``solver``, if its method carries continuous
@@ -221,7 +232,7 @@ def check_autonomous(params, who: str, solver=None) -> None:
         raise ParameterError(f"{who}: method {solver.method!r} of {params.model.name} carries "
                              f"a continuous memory slot; use another method (e.g. exact)")
     fa = params.model.forcing_amplitude
-    if fa and fa in params.model.param_names and float(getattr(params, fa)) != 0.0:
+    if is_forced(params):
         raise ParameterError(f"{who}: the system is forced ({fa} = {getattr(params, fa):g}): "
                              f"set {fa}=0 for a self-excited system, or use the stroboscopic "
                              f"analyses (poincare, periodic_orbit)")
@@ -243,6 +254,63 @@ class _Flow:
         self.T = params.period
         self.budget = max(1, int(math.ceil(max_time / self.T)))
         self.max_time = max_time
+        self.forced = is_forced(params)
+        from ..integrate.contract import OPT_PHASE
+        self.psi = float(self.setup.opts[OPT_PHASE])  # the forcing phase at a period's start
+
+    def record(self, state, skip, m):
+        """Advance ``state`` (in place) past ``skip`` crossings, then record the next ``m``:
+        (status, U (m x n), times since the last skipped crossing (since the start when
+        ``skip`` is 0), forcing phases omega t mod 2 pi at the crossings (None: autonomous)).
+        A forced system's field depends on t, so its runs go over whole forcing periods from
+        a period's start (``_forced_record``) and ``state`` ends at the end of the period of
+        the last crossing; an autonomous one stops on the crossings."""
+        if self.forced:
+            return self._forced_record(state, skip, m)
+        if skip:
+            status = self.crossings(state, skip)[0]
+            if status != "ok":
+                return f"transient: {status}", None, None, None
+        status, _, U, Tc, _ = self.crossings(state, m, record=m)
+        return status, U, Tc, None
+
+    def _forced_record(self, state, skip, m):
+        """``record`` of a forced system: runs of whole periods (their number estimated from
+        the crossings seen so far, at most 256), each recording every crossing it meets (run
+        again with room for all where more came than it had room for), until skip + m."""
+        n, total = self.model.n, skip + m
+        U = np.empty((total, n))
+        Tc = np.empty(total)
+        count, periods, chunk = 0, 0, 1
+        while count < total:
+            if periods >= self.budget:
+                return (f"no crossing: {count} of {total} crossings of the section within "
+                        f"{self.max_time:g} time units"), None, None, None
+            k = min(chunk, self.budget - periods)
+            cap = 4 * (total - count) + 64
+            while True:
+                s = state.copy()
+                SEC = np.array([self.direction, 0.0, 0.0, 0.0])
+                Ub, Tb = np.empty((cap, n)), np.empty(cap)
+                code, _ = self.setup.run(self.p, s, k, np.zeros((self.setup.N, 0)),
+                                         section=(self.H, SEC, Ub, Tb))
+                if code != st.OK:
+                    return f"integration failed: {st.message(code)}", None, None, None
+                got = int(SEC[2])
+                if got <= cap:
+                    break
+                cap = got
+            state[:] = s
+            take = min(got, total - count)
+            U[count:count + take] = Ub[:take]
+            Tc[count:count + take] = Tb[:take] + periods * self.T
+            count += take
+            periods += k
+            chunk = (min(256, 2 * chunk) if count == 0 else
+                     max(1, min(256, int(math.ceil((total - count) * periods / count)))))
+        phase = np.mod(self.psi + 2.0 * math.pi * Tc[skip:] / self.T, 2.0 * math.pi)
+        t = Tc[skip:] - (Tc[skip - 1] if skip else 0.0)
+        return "ok", U[skip:], t, phase
 
     def crossings(self, state, m, record=0, tangent=False):
         """Advance ``state`` (in place) to its m-th crossing; returns (status, time, U, T, Y):
@@ -307,11 +375,12 @@ def _start(params, solver, x0, v0, u0):
     return u, s
 
 
-def _setup(params, section, method, rtol, atol, max_time, who):
+def _setup(params, section, method, rtol, atol, max_time, who, forced_ok=False):
     from ..simulate import check_float, check_params
     params = check_params(params)
     solver = Solver(method=method, rtol=rtol, atol=atol, model=params.model)
-    check_autonomous(params, who, solver)
+    if not (forced_ok and is_forced(params)):
+        check_autonomous(params, who, solver)
     surface = parse_section(params, section)
     max_time = check_float("max_time", max_time)
     if not max_time > 0:
@@ -344,25 +413,28 @@ def surface_section(params, section="V", *, crossings: int = 200, transient: int
     time of those q crossings; NaN: none) and ``at_equilibrium`` (the crossings converge onto
     an equilibrium, a focus: no cycle). A surface the orbit stops crossing within
     ``max_time`` (per call: the transient, then the record) raises a one-line
-    IntegrationError."""
+    IntegrationError.
+
+    A forced system (its forcing amplitude not 0) is recorded too, with ``phase``, the
+    forcing phase omega t mod 2 pi at each crossing (its cycles: the crossings and their
+    phases repeat; ``at_equilibrium`` is 0). On a switching surface (``"Z"`` for the
+    bouncing ball) this is the impact map: each crossing is the event, recorded with the
+    state before the reset."""
     from ..simulate import check_int, start_attrs
     params, solver, flow, text = _setup(params, section, method, rtol, atol, max_time,
-                                        "surface_section")
+                                        "surface_section", forced_ok=True)
     crossings = check_int("crossings", crossings, 1)
     transient = check_int("transient", transient, 0)
     u_start, s = _start(params, solver, x0, v0, u0)
-    if transient:
-        status, _, _, _, _ = flow.crossings(s, transient)
-        if status != "ok":
-            raise IntegrationError(f"surface_section: transient: {status}")
-    status, _, U, Tc, _ = flow.crossings(s, crossings, record=crossings)
+    status, U, Tc, phase = flow.record(s, transient, crossings)
     if status != "ok":
         raise IntegrationError(f"surface_section: {status}")
     ret = np.diff(np.concatenate([[0.0], Tc]))
-    q_found, period, at_rest = _repetition(flow, s, U, Tc)
+    q_found, period, at_rest = _repetition(flow, s, U, Tc, phase)
     return xr.Dataset(
         {
             **_xv(params.model, "crossing", U, " at the crossing"),
+            **_phase_variable("crossing", phase),
             "t": ("crossing", Tc, {"long_name": "time since the last transient crossing",
                                    "units": "s"}),
             "return_time": ("crossing", ret, {"long_name": "time from the crossing before",
@@ -387,17 +459,28 @@ def surface_section(params, section="V", *, crossings: int = 200, transient: int
 EQUILIBRIUM_TOL = 1e-6
 
 
-def _repetition(flow, s, U, Tc):
+def _phase_variable(dims, phase) -> dict:
+    """The forcing phase at the crossings of a forced system's section (none: autonomous)."""
+    if phase is None:
+        return {}
+    return {"phase": (dims, phase, {"long_name": "forcing phase omega t mod 2 pi at the "
+                                                 "crossing", "units": "rad"})}
+
+
+def _repetition(flow, s, U, Tc, phase=None):
     """(q, cycle period, at rest) of recorded crossings U at times Tc, the state ``s`` after
-    the last: the smallest q <= 16 with U repeating after q crossings to 1e-6 (1 + ‖U‖) (0:
-    none; NaN period), and whether they converge onto an equilibrium (the field vanishes at
-    ``s`` to 1e-6: a focus, whose crossings repeat too but are no cycle)."""
+    the last: the smallest q <= 16 with U (and a forced system's forcing ``phase``, mod 2 pi)
+    repeating after q crossings to 1e-6 (1 + ‖U‖) (0: none; NaN period), and whether they
+    converge onto an equilibrium (an autonomous system's field vanishes at ``s`` to 1e-6: a
+    focus, whose crossings repeat too but are no cycle)."""
     crossings = len(U)
     q_found, period = 0, math.nan
     scale = 1.0 + float(np.max(np.abs(U)))
-    at_rest = float(np.linalg.norm(flow.field(s))) <= EQUILIBRIUM_TOL * scale
+    at_rest = phase is None and float(np.linalg.norm(flow.field(s))) <= EQUILIBRIUM_TOL * scale
     for q in range(1, 0 if at_rest else min(16, crossings // 2) + 1):
-        if np.max(np.abs(U[q:] - U[:-q])) <= 1e-6 * scale:
+        dph = 0.0 if phase is None else float(np.max(np.abs(np.angle(
+            np.exp(1j * (phase[q:] - phase[:-q]))))))
+        if max(float(np.max(np.abs(U[q:] - U[:-q]))), dph) <= 1e-6 * scale:
             q_found, period = q, float(np.mean([Tc[i + q] - Tc[i]
                                                 for i in range(crossings - q)]))
             break
@@ -445,7 +528,7 @@ def surface_bifurcation_diagram(params, param: str, values, section="V", *,
     transient = check_int("transient", transient, 0)
     params0, solver, _, text = _setup(params.replace(**{param: float(values[0])}), section,
                                       method, rtol, atol, max_time,
-                                      "surface_bifurcation_diagram")
+                                      "surface_bifurcation_diagram", forced_ok=True)
     u_start, s0 = _start(params0, solver, x0, v0, u0)
     n = params.model.n
     U = np.full((values.size, crossings, n), np.nan)
@@ -454,16 +537,15 @@ def surface_bifurcation_diagram(params, param: str, values, section="V", *,
     per = np.full(values.size, np.nan)
     rest = np.zeros(values.size, np.int8)
     status = np.zeros(values.size, np.int8)
+    PH = np.full((values.size, crossings), np.nan) if any(
+        is_forced(params.replace(**{param: float(v)})) for v in values) else None
     notes = []
     s = s0.copy()
     for i, v in enumerate(values):
         p_i, _, flow, _ = _setup(params.replace(**{param: float(v)}), section, method, rtol,
-                                 atol, max_time, "surface_bifurcation_diagram")
-        why = "ok"
-        if transient:
-            why = flow.crossings(s, transient)[0]
-        if why == "ok":
-            why, _, Ui, Tc, _ = flow.crossings(s, crossings, record=crossings)
+                                 atol, max_time, "surface_bifurcation_diagram",
+                                 forced_ok=True)
+        why, Ui, Tc, ph = flow.record(s, transient, crossings)
         if why != "ok":
             status[i] = 1
             notes.append(f"{param} = {v:g}: {why}")
@@ -471,12 +553,15 @@ def surface_bifurcation_diagram(params, param: str, values, section="V", *,
             continue
         U[i] = Ui
         RT[i] = np.diff(np.concatenate([[0.0], Tc]))
-        q[i], per[i], at_rest = _repetition(flow, s, Ui, Tc)
+        if ph is not None:
+            PH[i] = ph
+        q[i], per[i], at_rest = _repetition(flow, s, Ui, Tc, ph)
         rest[i] = int(at_rest)
     spec = params.model.param(param)
     return xr.Dataset(
         {
             **_xv(params.model, (param, "crossing"), U, " at the crossing"),
+            **_phase_variable((param, "crossing"), PH),
             "return_time": ((param, "crossing"), RT, {
                 "long_name": "time from the crossing before", "units": "s"}),
             "cycle_crossings": (param, q, {"long_name": "crossings per cycle (0: no "

@@ -163,13 +163,15 @@ def surface_bifurcation_cmd(
     rtol: RtolOpt = 1e-10,
     atol: AtolOpt = 1e-12,
     show: Annotated[Optional[str], typer.Option(
-        "--show", show_default=False, help="the state component plotted (default X)")] = None,
+        "--show", show_default=False,
+        help="the state component plotted (default X), or phase (a forced system)")] = None,
     out: OutOpt = None,
     plot: PlotOpt = None,
 ):
-    """Bifurcation diagram of a self-excited system on a section surface: at each value of
-    --param (each run continuing from the previous one), the crossings of the section after a
-    transient; cycles, their crossings per turn, and values that come to rest."""
+    """Bifurcation diagram on a section surface: at each value of --param (each run
+    continuing from the previous one), the crossings of the section after a transient; cycles,
+    their crossings per turn, and values that come to rest. A self-excited system, or a forced
+    one (an impact map on a switching surface, with the forcing phase: --show phase)."""
     params = load_params(preset, set_, model, method=method)
     from ..analysis.autonomous import surface_bifurcation_diagram
     from ..plot.autonomous import plot_surface_bifurcation
@@ -178,7 +180,13 @@ def surface_bifurcation_cmd(
     method = _method(params, method)
     preset = preset_label(params, preset, None)
     check_outputs(out, plot)
-    if show is not None:
+    if show == "phase":
+        from ..analysis.autonomous import is_forced
+        from ..errors import ParameterError
+        if not is_forced(params):
+            raise ParameterError("show: phase: only a forced system's crossings have a forcing "
+                                 "phase")
+    elif show is not None:
         check_show(f"{show},{show}", params.model.state_names)
     values = value_range(from_, to, steps, f"{param} range")
     ds = surface_bifurcation_diagram(params, param, values, (section, direction),

@@ -923,6 +923,37 @@ def _section_side_curved(curved, mode, tau, G, k, H, n, u, f, C, S, pp, mem, gr)
     return -1.0 if h < 0.0 else 1.0
 
 
+@nb.njit(cache=True, inline="always")
+def _record_crossing(U_sec, T_sec, n_sec, u, n, t):
+    """A crossing of the section at time t, state u, recorded where there is room
+    (``advance_tangent``): returns the new count."""
+    if n_sec < U_sec.shape[0]:
+        for i in range(n):
+            U_sec[n_sec, i] = u[i]
+        T_sec[n_sec] = t
+    return n_sec + 1
+
+
+@nb.njit(cache=True)
+def _section_hit(curved, mode, tau, G, k, H, n, u, f, C, S, om, pp, mem, gr, kc, curv):
+    """A state at a switching event on the section row k (written oriented, g = sgn h, by
+    ``_section_side``: |g| <= 1e-9 of its terms' scale) and moving across it (g' < 0): the
+    section crossed at the event's instant, e.g. a section on the guard's own surface (an
+    impact map). ``curv``: a curved section, evaluated as ``curved``'s k = ``kc``."""
+    if curv:
+        g, d = _curved_rate(curved, mode, kc, tau, C, S, n, u, f, pp, mem, gr)
+        scale = abs(g)
+        for i in range(n):
+            scale += abs(gr[i]) * (1.0 + abs(u[i]))
+    else:
+        g = _gval(G, k, n, u, C, S)
+        d = _dgval(G, k, n, f, C, S, om)
+        scale = abs(H[n]) + abs(H[n + 1]) + abs(H[n + 2])
+        for i in range(n):
+            scale += abs(H[i]) * (1.0 + abs(u[i]))
+    return abs(g) <= 1e-9 * scale and d < 0.0
+
+
 @nb.njit(cache=True, inline="always", fastmath=_FM)
 def _cf_state(MC, mode, om, y0, z0, C, S, hs, u1, f1):
     """Closed-form state at hs from the homogeneous part (y0, z0) and the forcing phase (C, S):
@@ -1950,11 +1981,7 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
             if k_tr >= 0 and k_tr == ksec:
                 # ---- a crossing of the section surface: record it, flip the row ----
                 if SEC[0] == 0.0 or SEC[0] == -sgn:
-                    if n_sec < U_sec.shape[0]:
-                        for i in range(n):
-                            U_sec[n_sec, i] = u[i]
-                        T_sec[n_sec] = t_done + (tau - t0)
-                    n_sec += 1
+                    n_sec = _record_crossing(U_sec, T_sec, n_sec, u, n, t_done + (tau - t0))
                 sgn = -sgn
                 for i in range(n + 3):
                     G[ksec, i] = -G[ksec, i]
@@ -1969,6 +1996,16 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
                 gdot = 0.0
                 old_mode = mode
                 label = ncv > 0 and math.isnan(G[k_tr, n]) and G[k_tr, n + 1] == 1.0
+                sec_stop = False
+                if has_sec and _section_hit(curved, mode, tau, G, ksec, H, n, u, f0, C, S, om,
+                                            pp, mem, gr, SECTION_K + (sgn < 0.0), csec):
+                    # the section's surface reached at this switching event (a section on the
+                    # guard's own surface: an impact map): a crossing, with the state before
+                    # the transition, which the reset would otherwise hide
+                    if SEC[0] == 0.0 or SEC[0] == -sgn:
+                        n_sec = _record_crossing(U_sec, T_sec, n_sec, u, n,
+                                                 t_done + (tau - t0))
+                        sec_stop = SEC[1] > 0.0 and n_sec >= SEC[1]
                 if tan and not label:
                     for i in range(n):
                         ue[i] = u[i]
@@ -2031,6 +2068,9 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
                     break
                 xmax = max(xmax, u[0])
                 xmin = min(xmin, u[0])
+                if sec_stop:  # stopped after the transition (its saltation in Y)
+                    SEC[3] = t_done + (tau - t0)
+                    break
         if code != st.OK:
             break
         if has_sec and SEC[1] > 0.0 and n_sec >= SEC[1]:
@@ -2096,7 +2136,10 @@ def advance_tangent(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out
     crossing, and ``SEC[3]`` the time since the call began (else the time integrated). A state
     on the surface at the start (within 1e-9 of its scale: a stop on a crossing) is not a
     crossing: the side it moves to counts; a reset that jumps across the surface is not one
-    either (the side is taken again after every transition). A curved surface: ``H[n]`` NaN,
+    either (the side is taken again after every transition). A switching event on the
+    surface, moving across it (a section on a guard's own surface: an impact map), is a
+    crossing, recorded with the state before the transition; a stop there comes after the
+    transition (Y with its saltation). A curved surface: ``H[n]`` NaN,
     h and its gradient from ``curved(mode, contract.SECTION_K, ...)`` of ``fns`` (a curved
     guard row)."""
     if Y.shape[0] != int(opts[OPT_N]) + len(cmi) or (qr == 1 and (

@@ -9,13 +9,17 @@ from .common import model_of, new_figure, param_symbol, param_title, shown_compo
 
 def plot_surface_bifurcation(ds, show: str | None = None):
     """The crossings of the section surface (one state component, ``show``: a name, default
-    X) against the swept parameter (``surface_bifurcation_diagram``); values where the orbit
-    comes to rest on an equilibrium or stops crossing are marked on the axis."""
+    X; or ``"phase"``, a forced system's forcing phase at the crossings) against the swept
+    parameter (``surface_bifurcation_diagram``); values where the orbit comes to rest on an
+    equilibrium or stops crossing are marked on the axis."""
     fig, ax = new_figure(figsize=(7.5, 4.6))
     param = ds.attrs["param"]
     names = str(ds.attrs.get("state_names", "X V")).split()
-    pair = (show or names[0], names[1] if (show or names[0]) != names[1] else names[0])
-    _, _, label, _, U, _ = shown_components(ds, pair)
+    if show == "phase" and "phase" in ds:
+        label, U = r"forcing phase $\omega t$ mod $2\pi$", ds.phase.values
+    else:
+        pair = (show or names[0], names[1] if (show or names[0]) != names[1] else names[0])
+        _, _, label, _, U, _ = shown_components(ds, pair)
     lam = ds[param].values
     ax.plot(np.repeat(lam[:, None], U.shape[1], axis=1).ravel(), U.ravel(), ",", color="k",
             alpha=0.7)
