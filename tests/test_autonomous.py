@@ -251,6 +251,19 @@ def test_a_curved_section_gives_the_closed_form_cycle_and_the_same_period_and_mu
     assert V < 0.0  # the arc's lower half: there h decreases along the flow
 
 
+def test_a_projection_onto_a_curved_section_lands_on_it_or_says_it_missed():
+    """``Surface.project`` (the Newton steps of limit cycles and of continuation on a curved
+    section): along X onto the circle X^2 + V^2 = 4 from (3, 0.1), the circle's point; along V
+    from there, a line that misses the circle: NaN, never a point off the surface."""
+    from nonsmooth.analysis.autonomous import parse_section
+    p = M.params()
+    circle = parse_section(p, "X**2 + V**2 - 4")
+    on = circle.project(np.array([3.0, 0.1]), np.array([1.0, 0.0]), p.pack())
+    assert on == pytest.approx([math.sqrt(4 - 0.01), 0.1], abs=1e-14)
+    assert np.all(np.isnan(circle.project(np.array([3.0, 0.1]), np.array([0.0, 1.0]),
+                                          p.pack())))
+
+
 VDP = """import nonsmooth as ns
 MODEL = ns.model_from_equations(
     "van_der_pol", states=("X", "V"), parameters={"mu": 1.0},

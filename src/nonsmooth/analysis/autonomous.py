@@ -152,7 +152,9 @@ class Surface:
 
     def project(self, z, a, p, iters: int = 8):
         """z moved along the direction ``a`` onto the surface: Newton on h(z + s a) = 0 (at
-        most ``iters`` steps; an affine surface in one)."""
+        most ``iters`` steps; an affine surface in one). NaN where the line misses the
+        surface or Newton ends farther than 1e-10 (1 + |z|) from it (h / |grad h|): the
+        callers' Newton and continuation steps then fail there and are shortened."""
         z = np.array(z, float)
         if not self.curved:
             return z - (self.value(z, p) / float(a @ a)) * a
@@ -164,6 +166,9 @@ class Surface:
             z = z - (h / d) * a
             if abs(h) <= 1e-15 * (1.0 + float(np.linalg.norm(z))):
                 break
+        g = float(np.linalg.norm(self.gradient(z, p)))
+        if not abs(self.value(z, p)) <= 1e-10 * (1.0 + float(np.linalg.norm(z))) * g:
+            return np.full_like(z, np.nan)
         return z
 
     def fns(self, fns, model, method):
