@@ -422,9 +422,9 @@ def surface_section(params, section="V", *, crossings: int = 200, transient: int
 
     A forced system (its forcing amplitude not 0) is recorded too, with ``phase``, the
     forcing phase omega t mod 2 pi at each crossing (its cycles: the crossings and their
-    phases repeat; ``at_equilibrium`` is 0). On a switching surface (``"Z"`` for the
-    bouncing ball) this is the impact map: each crossing is the event, recorded with the
-    state before the reset."""
+    phases repeat; ``at_equilibrium`` is 0; ``max_time`` bounds the transient and the record
+    together). On a switching surface (``"Z"`` for the bouncing ball) this is the impact
+    map: each crossing is the event, recorded with the state before the reset."""
     from ..simulate import check_int, start_attrs
     params, solver, flow, text = _setup(params, section, method, rtol, atol, max_time,
                                         "surface_section", forced_ok=True)
@@ -525,7 +525,9 @@ def surface_bifurcation_diagram(params, param: str, values, section="V", *,
     to 1e-6; 0: none, e.g. chaos or a torus), ``cycle_period``, ``at_equilibrium`` (the
     crossings converge onto an equilibrium) and ``status`` (0 ok; 1 the orbit failed or
     stopped crossing within ``max_time``: NaN crossings, and the sweep goes on from the start
-    state). A failing value never stops the sweep."""
+    state). A failing value never stops the sweep. A forced system's crossings also carry
+    ``phase`` (param, crossing), the forcing phase at each (see ``surface_section``: on a
+    switching surface, the impact map)."""
     from ..simulate import check_int, check_params, start_attrs
     params = check_params(params)
     param, values = _param_values(params, param, values)
