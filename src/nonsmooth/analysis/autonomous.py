@@ -289,7 +289,8 @@ class _Flow:
         count, periods, chunk = 0, 0, 1
         while count < total:
             if periods >= self.budget:
-                return (f"no crossing: {count} of {total} crossings of the section within "
+                return (f"no crossing: {count} of {total} crossings of the section in its "
+                        f"direction ({skip} transient, {m} recorded) within "
                         f"{self.max_time:g} time units"), None, None, None
             k = min(chunk, self.budget - periods)
             cap = 4 * (total - count) + 64
@@ -409,9 +410,9 @@ def surface_section(params, section="V", *, crossings: int = 200, transient: int
                     x0: float = 0.0, v0: float = 0.0, u0=None, method: str = "exact",
                     rtol: float = 1e-10, atol: float = 1e-12,
                     max_time: float = 1e4) -> xr.Dataset:
-    """Poincaré section of a self-excited system on a surface: from (x0, v0) (or ``u0``), skip
-    ``transient`` crossings, then record ``crossings`` crossings of ``section`` (see the module
-    docstring) in its direction. Returns a Dataset over ``crossing`` with the state (``X``,
+    """Poincaré section on a surface (of a self-excited system; of a forced one, below): from
+    (x0, v0) (or ``u0``), skip ``transient`` crossings, then record ``crossings`` crossings of
+    ``section`` (see the module docstring) in its direction. Returns a Dataset over ``crossing`` with the state (``X``,
     ``V`` and one variable per further component, ``io.components(ds)``), the time ``t`` since the last transient crossing and the
     ``return_time`` from the crossing before; scalars ``cycle_crossings`` (the smallest q <= 16
     with u repeating after q crossings to 1e-6 (1 + ‖u‖); 0: none), ``cycle_period`` (the

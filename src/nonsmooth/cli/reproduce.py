@@ -20,7 +20,9 @@ def reproduce_cmd(
         "--only", help="comma-separated figure ids, e.g. fig9,fig11 (fig6 = fig6a,fig6b); the "
                        "report in --out keeps the other figures of earlier runs")] = None,
     quick: Annotated[bool, typer.Option(
-        "--quick/--full", metavar="", help="coarse grids, short runs (< 2 min), or full "
+        "--quick/--full", metavar="", help="coarse grids, short runs (about 15 s once "
+                                           "the kernels are compiled; the first run on a "
+                                           "machine compiles them, 2 to 4 minutes), or full "
                                            "resolution")] = False,
     workers: WorkersOpt = None,
 ):

@@ -21,9 +21,12 @@ def plot_surface_bifurcation(ds, show: str | None = None):
         pair = (show or names[0], names[1] if (show or names[0]) != names[1] else names[0])
         _, _, label, _, U, _ = shown_components(ds, pair)
     lam = ds[param].values
-    ax.plot(np.repeat(lam[:, None], U.shape[1], axis=1).ravel(), U.ravel(), ",", color="k",
-            alpha=0.7)
-    ax.scatter(lam, np.nanmax(U, axis=1), s=2, color="k")  # visible also for few crossings
+    x = np.repeat(lam[:, None], U.shape[1], axis=1).ravel()
+    if show == "phase" and "phase" in ds:  # every crossing visible: a branch's max would
+        ax.scatter(x, U.ravel(), s=2, color="k", lw=0)  # hide a doubling's other branch
+    else:
+        ax.plot(x, U.ravel(), ",", color="k", alpha=0.7)
+        ax.scatter(lam, np.nanmax(U, axis=1), s=2, color="k")  # visible also for few crossings
     rest = ds.at_equilibrium.values.astype(bool) | (ds.status.values != 0)
     if rest.any():
         lo = np.nanmin(U) if np.isfinite(U).any() else 0.0
