@@ -412,8 +412,9 @@ def surface_section(params, section="V", *, crossings: int = 200, transient: int
                     max_time: float = 1e4) -> xr.Dataset:
     """Poincaré section on a surface (of a self-excited system; of a forced one, below): from
     (x0, v0) (or ``u0``), skip ``transient`` crossings, then record ``crossings`` crossings of
-    ``section`` (see the module docstring) in its direction. Returns a Dataset over ``crossing`` with the state (``X``,
-    ``V`` and one variable per further component, ``io.components(ds)``), the time ``t`` since the last transient crossing and the
+    ``section`` (see the module docstring) in its direction. Returns a Dataset over
+    ``crossing`` with the state (``X``, ``V`` and one variable per further component,
+    ``io.components(ds)``), the time ``t`` since the last transient crossing and the
     ``return_time`` from the crossing before; scalars ``cycle_crossings`` (the smallest q <= 16
     with u repeating after q crossings to 1e-6 (1 + ‖u‖); 0: none), ``cycle_period`` (the
     time of those q crossings; NaN: none) and ``at_equilibrium`` (the crossings converge onto
