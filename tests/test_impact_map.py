@@ -109,3 +109,37 @@ def test_the_impact_map_on_the_cli_shows_the_phase(tmp_path, capsys):
                             "--to", "0.3", "--steps", "2", "--show", "phase"], capsys)
     assert code == 2
     one_line(err, "show: phase: only a forced system's crossings have a forcing phase")
+
+
+def test_the_compliant_impact_oscillators_contacts_against_scipy():
+    """The smooth ``impact`` model (a stiff spring-damper beyond X = 1, RKF45): its section on
+    the contact surface X - 1 counts every onset (increasing) and every separation
+    (decreasing) of an independent event-driven solution (scipy DOP853, 1e-12) once, at its
+    time to 1e-8. The RKF45's located event may lie past the surface by about 1e-8, which
+    must still count as the crossing (a review found 8 of 20 onsets at the default
+    tolerance before)."""
+    from scipy.integrate import solve_ivp
+    from nonsmooth.models.impact import contact_damping
+    p = ns.model("impact").params(F0=4.0, omega=2.0, r=0.7, xi=0.1, k_c=1e3)
+    c = contact_damping(p.r, p.k_c)
+
+    def f(t, u, contact):
+        a = -p.omega0**2 * u[0] - p.xi * u[1] + p.F0 * math.cos(p.omega * t)
+        return [u[1], a - (p.k_c * (u[0] - 1) + c * u[1] if contact else 0.0)]
+
+    t, u, contact, ref = 0.0, np.array([0.0, 0.5]), False, {True: [], False: []}
+    while True:
+        def ev(t, u, *a):
+            return u[0] - 1.0
+        ev.terminal, ev.direction = True, (-1 if contact else 1)
+        s = solve_ivp(f, (t, 25.0), u, args=(contact,), events=ev, method="DOP853",
+                      rtol=1e-12, atol=1e-13)
+        if not s.t_events[0].size:
+            break
+        t, u = s.t_events[0][0], s.y_events[0][0].copy()
+        ref[not contact].append(t)
+        contact = not contact
+    for direction, times in (("increasing", ref[True]), ("decreasing", ref[False])):
+        ds = ns.surface_section(p, ("X - 1", direction), crossings=len(times), transient=0,
+                                x0=0.0, v0=0.5, method="smooth", max_time=25.0)
+        assert len(times) == 8 and np.allclose(ds.t.values, times, atol=1e-8, rtol=0)

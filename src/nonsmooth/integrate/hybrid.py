@@ -937,9 +937,12 @@ def _record_crossing(U_sec, T_sec, n_sec, u, n, t):
 @nb.njit(cache=True)
 def _section_hit(curved, mode, tau, G, k, H, n, u, f, C, S, om, pp, mem, gr, kc, curv):
     """A state at a switching event on the section row k (written oriented, g = sgn h, by
-    ``_section_side``: |g| <= 1e-9 of its terms' scale) and moving across it (g' < 0): the
+    ``_section_side``: g <= 1e-9 of its terms' scale) and moving across it (g' < 0): the
     section crossed at the event's instant, e.g. a section on the guard's own surface (an
-    impact map). ``curv``: a curved section, evaluated as ``curved``'s k = ``kc``."""
+    impact map). The event's state may lie past the surface by its location's error (1e-8 on
+    a long RKF45 step): a section crossed earlier in the step would have been located first,
+    so g < 0 is this crossing. ``curv``: a curved section, evaluated as ``curved``'s k =
+    ``kc``."""
     if curv:
         g, d = _curved_rate(curved, mode, kc, tau, C, S, n, u, f, pp, mem, gr)
         scale = abs(g)
@@ -951,7 +954,7 @@ def _section_hit(curved, mode, tau, G, k, H, n, u, f, C, S, om, pp, mem, gr, kc,
         scale = abs(H[n]) + abs(H[n + 1]) + abs(H[n + 2])
         for i in range(n):
             scale += abs(H[i]) * (1.0 + abs(u[i]))
-    return abs(g) <= 1e-9 * scale and d < 0.0
+    return g <= 1e-9 * scale and d < 0.0
 
 
 @nb.njit(cache=True, inline="always", fastmath=_FM)
