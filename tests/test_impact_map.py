@@ -92,6 +92,14 @@ def test_a_self_excited_section_on_the_stick_surface_counts_each_arrival():
     assert np.allclose(ds.V.values, p.v_belt, atol=1e-12, rtol=0)
     assert np.allclose(ds.return_time.values[1:], period, atol=1e-9, rtol=0)
     assert int(ds.cycle_crossings) == 1 and "phase" not in ds
+    # the cycle on that surface by Newton: its map runs from one arrival's state (before the
+    # switch into sticking, where the flow crosses the surface) to the next; sticking merges
+    # the arrivals, so its multiplier is 0
+    lc = ns.limit_cycle(p, ("V - v_belt", "increasing"), v0=1.0)
+    assert lc.attrs["status"] == "converged"
+    assert float(lc.period) == pytest.approx(period, abs=1e-9)
+    assert float(lc.X_section) == pytest.approx((2 * p.mu_k - p.mu_s) / p.omega0**2, abs=1e-9)
+    assert float(lc.multiplier_abs[0]) < 1e-9
 
 
 def test_the_impact_map_on_the_cli_shows_the_phase(tmp_path, capsys):

@@ -1999,16 +1999,18 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
                 gdot = 0.0
                 old_mode = mode
                 label = ncv > 0 and math.isnan(G[k_tr, n]) and G[k_tr, n + 1] == 1.0
-                sec_stop = False
                 if has_sec and _section_hit(curved, mode, tau, G, ksec, H, n, u, f0, C, S, om,
                                             pp, mem, gr, SECTION_K + (sgn < 0.0), csec):
                     # the section's surface reached at this switching event (a section on the
                     # guard's own surface: an impact map): a crossing, with the state before
-                    # the transition, which the reset would otherwise hide
+                    # the transition, which the reset would otherwise hide; a stop there is
+                    # made before the transition (the next run takes it at its start)
                     if SEC[0] == 0.0 or SEC[0] == -sgn:
                         n_sec = _record_crossing(U_sec, T_sec, n_sec, u, n,
                                                  t_done + (tau - t0))
-                        sec_stop = SEC[1] > 0.0 and n_sec >= SEC[1]
+                        if SEC[1] > 0.0 and n_sec >= SEC[1]:
+                            SEC[3] = t_done + (tau - t0)
+                            break
                 if tan and not label:
                     for i in range(n):
                         ue[i] = u[i]
@@ -2071,9 +2073,6 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
                     break
                 xmax = max(xmax, u[0])
                 xmin = min(xmin, u[0])
-                if sec_stop:  # stopped after the transition (its saltation in Y)
-                    SEC[3] = t_done + (tau - t0)
-                    break
         if code != st.OK:
             break
         if has_sec and SEC[1] > 0.0 and n_sec >= SEC[1]:
@@ -2141,8 +2140,9 @@ def advance_tangent(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out
     crossing: the side it moves to counts; a reset that jumps across the surface is not one
     either (the side is taken again after every transition). A switching event on the
     surface, moving across it (a section on a guard's own surface: an impact map), is a
-    crossing, recorded with the state before the transition; a stop there comes after the
-    transition (Y with its saltation). A curved surface: ``H[n]`` NaN,
+    crossing, recorded with the state before the transition; a stop there comes before the
+    transition, which the next call takes at its start (the map from one event's state to
+    the next's). A curved surface: ``H[n]`` NaN,
     h and its gradient from ``curved(mode, contract.SECTION_K, ...)`` of ``fns`` (a curved
     guard row)."""
     if Y.shape[0] != int(opts[OPT_N]) + len(cmi) or (qr == 1 and (
