@@ -546,8 +546,7 @@ def surface_bifurcation_diagram(params, param: str, values, section="V", *,
     per = np.full(values.size, np.nan)
     rest = np.zeros(values.size, np.int8)
     status = np.zeros(values.size, np.int8)
-    PH = np.full((values.size, crossings), np.nan) if any(
-        is_forced(params.replace(**{param: float(v)})) for v in values) else None
+    PH = None  # the forcing phases, from the first forced value on (an autonomous system: none)
     notes = []
     s = s0.copy()
     for i, v in enumerate(values):
@@ -563,6 +562,7 @@ def surface_bifurcation_diagram(params, param: str, values, section="V", *,
         U[i] = Ui
         RT[i] = np.diff(np.concatenate([[0.0], Tc]))
         if ph is not None:
+            PH = np.full((values.size, crossings), np.nan) if PH is None else PH
             PH[i] = ph
         q[i], per[i], at_rest = _repetition(flow, s, Ui, Tc, ph)
         rest[i] = int(at_rest)
