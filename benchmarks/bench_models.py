@@ -135,9 +135,15 @@ def propagation(model, params, method) -> str:
     n = model.n
     fns, p, out = model.fns(method), params.pack(), np.zeros(max(4, n * n + 3 * n))
     modes = m.modes or tuple(range(len(model.mode_names)))
-    kinds = {1: "oscillator", 2: "series"}
-    closed = [f"{model.mode_names[k]} ({kinds[r]})" for k in modes
-              if (r := int(call_linear(fns, k, p, out))) in kinds]
+    def kind(r):  # (as ``hybrid._mode_class``: a general row of the oscillator's form, or of
+        if r == 2 and n == 2 and out[0] == 0 and out[1] == 1 \
+                and out[4] == out[6] == out[8] == 0 and (  # free flight, is an oscillator)
+                    (out[2] < 0 and out[3] <= 0) or (out[2] == 0 and out[3] == 0)):
+            return "oscillator"
+        return {1: "oscillator", 2: "series"}.get(r)
+
+    closed = [f"{model.mode_names[k]} ({w})" for k in modes
+              if (w := kind(int(call_linear(fns, k, p, out))))]
     return f"closed form in {', '.join(closed)}" if closed else "RKF45 (no linear mode)"
 
 

@@ -291,7 +291,7 @@ def _x_extrema_exact(MC, m, om, F, y0, z0, C, S, X, V, X1, V1, h, xmax, xmin):
                 if abs(ds) <= _EXT_STEP * h and 0.0 <= s + ds <= h:
                     Xs -= 0.5 * Vs * Vs / As  # = X + V ds + A ds^2 / 2
                     break
-                den = 2.0 * As * As - Vs * jerk(MC, m, om, F, Vs, As, Ss)  # Halley
+                den = 2.0 * As * As - Vs * jerk(MC, m, om, F, Vs, As, Cs, Ss)  # Halley
                 if den > 0.0:
                     ds = -2.0 * Vs * As / den
                 sn = min(h, max(0.0, s + ds))
@@ -328,7 +328,7 @@ def _g_full(cf, s, G, k, n, q0, q1, q2, q3, C, S, om, hs, MC, mode, y0, z0, F):
     cubic Hermite of the state (projection q0..q3), with the exact forcing terms of the guard."""
     if cf:
         X, V, A, y, z, Cs, Ss = eval_state(MC, mode, om, y0, z0, C, S, s * hs)
-        Jk = jerk(MC, mode, om, F, V, A, Ss)
+        Jk = jerk(MC, mode, om, F, V, A, Cs, Ss)
         g = G[k, 0] * X + G[k, 1] * V
         d = G[k, 0] * V + G[k, 1] * A
         dd = G[k, 0] * A + G[k, 1] * Jk
@@ -373,7 +373,7 @@ def _g_dd(cf, G, k, n, u, f, C, S, om, MC, mode, F, cdd, hs):
     RKF45 step ``cdd`` is the second derivative of the state cubic's projection there, per
     fraction squared)."""
     if cf:
-        dd = G[k, 0] * f[1] + G[k, 1] * jerk(MC, mode, om, F, u[1], f[1], S)
+        dd = G[k, 0] * f[1] + G[k, 1] * jerk(MC, mode, om, F, u[1], f[1], C, S)
     else:
         dd = cdd / (hs * hs)
     return dd - om * om * (G[k, n + 1] * C + G[k, n + 2] * S)
@@ -473,7 +473,7 @@ def _locate_cf(lo, hi, glo, ghi, G, k, om, hs, MC, mode, y0, z0, C, S, F):
             glo = g
         if hi - lo <= S_TOL:
             break
-        J = jerk(MC, mode, om, F, V, A, Ss)
+        J = jerk(MC, mode, om, F, V, A, Cs, Ss)
         d = hs * (a0 * V + a1 * A + om * (a4 * Cs - a3 * Ss))
         dd = hs * hs * (a0 * A + a1 * J - om2 * (a3 * Cs + a4 * Ss))
         sn = -1.0
@@ -521,6 +521,23 @@ def frame_omega(pp, opts):
 
 
 @nb.njit(cache=True)
+def _oscillator(lin, om, mc):
+    """A general-form ``linear`` row (n = 2) that is the oscillator X' = V,
+    V' = -k X - c V + b + f_c cos(omega t) + f_s sin(omega t) with k > 0 and c >= 0, or free
+    flight (k = c = 0): fill its closed-form row ``mc`` (``pwlinear.mode_coeffs``) and return
+    True; False for any other form, and for an undamped mode forced at resonance (the
+    series of ``linmodes`` takes those)."""
+    if not (lin[0] == 0.0 and lin[1] == 1.0 and lin[4] == 0.0 and lin[6] == 0.0
+            and lin[8] == 0.0):
+        return False
+    k = -lin[2]
+    c = -lin[3]
+    if not ((k > 0.0 and c >= 0.0) or (k == 0.0 and c == 0.0)):
+        return False
+    return mode_coeffs(k, c, lin[5], lin[7], om, THETA, mc, lin[9])
+
+
+@nb.njit(cache=True)
 def _mode_class(linear, closed, mode, pp, lin, MC, mcs, om, MF, n, MXR, PW):
     """_MC_CLOSED / _MC_RK / _MC_RESONANT / _MC_POLY for ``mode``, filling the table row (and
     the forcing amplitude ``MF[mode]``, or the series' matrices M^j / j! ``PW[mode]`` of the
@@ -536,6 +553,9 @@ def _mode_class(linear, closed, mode, pp, lin, MC, mcs, om, MF, n, MXR, PW):
                 mcs[mode] = _MC_CLOSED
             else:
                 mcs[mode] = _MC_RESONANT
+        elif r == 2 and n == 2 and _oscillator(lin, om, MC[mode]):
+            MF[mode] = lin[7]
+            mcs[mode] = _MC_CLOSED
         elif r == 2:
             MXR[mode] = lin_matrix(lin, n, om, PW[mode, :, 1])
             series_powers(n + 3, PW[mode])

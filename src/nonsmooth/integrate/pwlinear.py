@@ -54,11 +54,14 @@ MC_KIND = 7    # KIND_UNDER / KIND_CRIT / KIND_OVER
 MC_NU = 8      # damped frequency (under) or mu = sqrt(c^2/4 - k) (over)
 MC_SQK = 9     # sqrt(k)
 MC_LMAX = 10   # longest piece tried in this mode
-N_MC = 11
+MC_G = 11      # constant acceleration of a free mode (KIND_FREE: k = c = 0), else 0
+MC_FS = 12     # amplitude F_s of a forcing term F_s sin(omega t) (0: cosine forcing only)
+N_MC = 13
 
 KIND_UNDER = 0
 KIND_CRIT = 1
 KIND_OVER = 2
+KIND_FREE = 3  # k = c = 0: free flight under a constant force b (gravity) and the forcing
 
 # ---- bound coefficients of a functional in a mode -------------------------------------------
 BD_D2 = 0  # dual norm of (cx, cv) A^2
@@ -72,29 +75,42 @@ HERM_DERR = 1.0 / 60.0   # max |g' - H'| <= sqrt(3)/216 L^3 max|g''''|, with a s
 
 
 @nb.njit(cache=True)
-def mode_coeffs(k, c, b, F0, om, theta, out):
-    """Fill ``out`` (length N_MC) for X'' + c X' + k X = F0 cos(om t) + b.
+def mode_coeffs(k, c, b, F0, om, theta, out, Fs=0.0):
+    """Fill ``out`` (length N_MC) for X'' + c X' + k X = F0 cos(om t) + Fs sin(om t) + b, with
+    k > 0 and c >= 0, or k = c = 0 (KIND_FREE: free flight, X = b s^2 / 2 + V0 s + X0 plus the
+    harmonic part; the constant force is then carried by the homogeneous pair (y, z), see
+    ``apply_propagator``).
 
     ``theta``: longest piece = theta / max(sqrt(k), om) (radians of the fastest oscillation).
-    Returns False for an undamped mode forced (F0 != 0) exactly at resonance (no bounded particular
-    solution; the exact kernels return a status for it).
+    Returns False for an undamped mode forced (F0, Fs != 0) exactly at resonance (no bounded
+    particular solution; the exact kernels return a status for it).
     """
     d = k - om * om
     den = d * d + (c * om) ** 2
     if not den > 1e-300:
-        if F0 != 0.0:
+        if F0 != 0.0 or Fs != 0.0:
             return False
         den = 1.0  # unforced: no particular harmonic part, nothing resonates
+    free = k == 0.0
     out[MC_K] = k
     out[MC_C] = c
     out[MC_B] = b
-    out[MC_XS] = b / k
-    out[MC_P] = F0 * d / den
-    out[MC_Q] = F0 * c * om / den
+    out[MC_XS] = 0.0 if free else b / k
+    out[MC_G] = b if free else 0.0
+    out[MC_FS] = Fs
+    if Fs == 0.0:
+        out[MC_P] = F0 * d / den
+        out[MC_Q] = F0 * c * om / den
+    else:  # (d P + c om Q, d Q - c om P) = (F0, Fs)
+        out[MC_P] = (F0 * d - Fs * c * om) / den
+        out[MC_Q] = (F0 * c * om + Fs * d) / den
     a = -0.5 * c
     out[MC_A] = a
     disc = 0.25 * c * c - k
-    if disc < 0.0:
+    if free:
+        out[MC_KIND] = KIND_FREE
+        out[MC_NU] = 0.0
+    elif disc < 0.0:
         out[MC_KIND] = KIND_UNDER
         out[MC_NU] = math.sqrt(-disc)
     elif disc > 0.0:
@@ -113,7 +129,17 @@ def mode_coeffs(k, c, b, F0, om, theta, out):
 @nb.njit(cache=True)
 def functional_bounds(mc, om, cx, cv, out):
     """Fill ``out`` (length N_BD) with the derivative-bound coefficients of g = cx X + cv V + c0
-    in mode ``mc``: |g^(n)| <= D_n sqrt(k y^2 + z^2) + om^n R over any piece (see module doc)."""
+    in mode ``mc``: |g^(n)| <= D_n sqrt(k y^2 + z^2) + om^n R over any piece (see module doc).
+    A free mode (KIND_FREE): g_hom'' = cx b and its higher derivatives vanish, so D_n = 0
+    and |cx b| / om^2 is added to R (om^2 R then bounds g'' too)."""
+    if mc[MC_KIND] == KIND_FREE:
+        out[BD_D2] = 0.0
+        out[BD_D3] = 0.0
+        out[BD_D4] = 0.0
+        out[BD_R] = (math.hypot(cx * mc[MC_P] + cv * om * mc[MC_Q],
+                                cx * mc[MC_Q] - cv * om * mc[MC_P])
+                     + abs(cx * mc[MC_G]) / (om * om))
+        return
     k = mc[MC_K]
     c = mc[MC_C]
     w1 = cx
@@ -141,12 +167,16 @@ def hom_part(MC, m, om, X, V, C, S):
 @nb.njit(cache=True, inline="always")
 def accel(MC, m, om, y, z, C, S):
     """X'' from the homogeneous part and the forcing phase."""
+    if MC[m, MC_KIND] == KIND_FREE:  # (a branch of its own: the other kinds' arithmetic is
+        return -om * om * (MC[m, MC_P] * C + MC[m, MC_Q] * S) + MC[m, MC_G]  # as it was)
     return -om * om * (MC[m, MC_P] * C + MC[m, MC_Q] * S) - MC[m, MC_K] * y - MC[m, MC_C] * z
 
 
 @nb.njit(cache=True, inline="always")
-def jerk(MC, m, om, F0, V, A, S):
-    """X''' = -k V - c X'' - F0 om sin(om t)."""
+def jerk(MC, m, om, F0, V, A, C, S):
+    """X''' = -k V - c X'' - F0 om sin(om t) + Fs om cos(om t)."""
+    if MC[m, MC_FS] != 0.0:
+        return -MC[m, MC_K] * V - MC[m, MC_C] * A - F0 * om * S + MC[m, MC_FS] * om * C
     return -MC[m, MC_K] * V - MC[m, MC_C] * A - F0 * om * S
 
 
@@ -167,6 +197,9 @@ def propagator(MC, m, om, s):
         e1 = math.exp((a + mu) * s)
         eS = e1 * (-math.expm1(-2.0 * mu * s)) / (2.0 * mu)  # e^{as} sinh(mu s) / mu
         eC = e1 - mu * eS                                    # e^{as} cosh(mu s)
+    elif kind == KIND_FREE:
+        eC = 1.0
+        eS = s
     else:
         e = math.exp(a * s)
         eC = e
@@ -188,8 +221,25 @@ def propagator_table(MC, m, om, n_levels, out):
 
 
 @nb.njit(cache=True, inline="always")
+def _apply_free(MC, m, om, y0, z0, C0, S0, s, cw, sw):
+    """``apply_propagator`` of a free mode (KIND_FREE, k = c = 0) over s: the pair (y, z)
+    carries the constant force b, y = y0 + z0 s + b s^2 / 2 and z = z0 + b s."""
+    C = C0 * cw - S0 * sw
+    S = S0 * cw + C0 * sw
+    b = MC[m, MC_G]
+    y = y0 + s * (z0 + 0.5 * b * s)
+    z = z0 + b * s
+    P = MC[m, MC_P]
+    Q = MC[m, MC_Q]
+    hp = P * C + Q * S
+    return hp + y, om * (Q * C - P * S) + z, b - om * om * hp, y, z, C, S
+
+
+@nb.njit(cache=True, inline="always")
 def apply_propagator(MC, m, om, y0, z0, C0, S0, eC, eS, cw, sw):
     """State after a step with a precomputed propagator: (X, V, A, y, z, C, S)."""
+    if MC[m, MC_KIND] == KIND_FREE:  # (a branch of its own: the other kinds' arithmetic is
+        return _apply_free(MC, m, om, y0, z0, C0, S0, eS, cw, sw)  # as it was)
     C = C0 * cw - S0 * sw
     S = S0 * cw + C0 * sw
     a = MC[m, MC_A]

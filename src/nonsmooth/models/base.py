@@ -65,7 +65,9 @@ signatures of :mod:`nonsmooth.integrate.contract`). It declares
       f_s sin(omega t) with constant coefficients (out[0:n*n] = A row-major, then b, f_c,
       f_s, n each; ``out`` has max(4, n^2 + 3n) slots): with ``closed_form=True`` the method then propagates it in closed form
       (the oscillator's formulas, or the series of the augmented matrix exponential,
-      :mod:`nonsmooth.integrate.linmodes`).
+      :mod:`nonsmooth.integrate.linmodes`). A general row with n = 2 that is the oscillator
+      (X' = V, V' = -k X - c V + b + f_c cos + f_s sin, k > 0 and c >= 0, or free flight,
+      k = c = 0) takes the oscillator's formulas too (``integrate.pwlinear``).
 
 * what analyses and plots need: ``contact(params, mask, max_X, min_X)`` (does an orbit with
   this visited-mode mask and these extremes of X count as "in contact", named
