@@ -520,19 +520,34 @@ def frame_omega(pp, opts):
     return f
 
 
+#: a general row takes the oscillator's formulas only where they are well conditioned
+#: (``_oscillator``); elsewhere the series
+OSC_COND = 1e-3
+
+
 @nb.njit(cache=True)
 def _oscillator(lin, om, mc):
     """A general-form ``linear`` row (n = 2) that is the oscillator X' = V,
     V' = -k X - c V + b + f_c cos(omega t) + f_s sin(omega t) with k > 0 and c >= 0, or free
     flight (k = c = 0): fill its closed-form row ``mc`` (``pwlinear.mode_coeffs``) and return
-    True; False for any other form, and for an undamped mode forced at resonance (the
-    series of ``linmodes`` takes those)."""
+    True; False for any other form, and where the oscillator's formulas are ill-conditioned
+    (the series of ``linmodes``, exact to round-off, takes those): a weak spring,
+    k < OSC_COND max(om^2, c^2 / 4), whose static offset b / k and slow homogeneous part
+    cancel; a mode near resonance, |k - om^2 + i c om| < OSC_COND max(k, om^2), whose
+    particular harmonic and homogeneous part cancel (a loss of about eps / OSC_COND of the
+    state, against eps |b| / k and eps F / |k - om^2 + i c om| otherwise); an undamped mode
+    forced at resonance."""
     if not (lin[0] == 0.0 and lin[1] == 1.0 and lin[4] == 0.0 and lin[6] == 0.0
             and lin[8] == 0.0):
         return False
     k = -lin[2]
     c = -lin[3]
-    if not ((k > 0.0 and c >= 0.0) or (k == 0.0 and c == 0.0)):
+    if k == 0.0 and c == 0.0:
+        return mode_coeffs(k, c, lin[5], lin[7], om, THETA, mc, lin[9])
+    om2 = om * om
+    d = k - om2
+    if not (k >= OSC_COND * max(om2, 0.25 * c * c) and c >= 0.0
+            and d * d + (c * om) ** 2 >= (OSC_COND * max(k, om2)) ** 2):
         return False
     return mode_coeffs(k, c, lin[5], lin[7], om, THETA, mc, lin[9])
 
