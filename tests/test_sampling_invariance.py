@@ -43,7 +43,7 @@ def _cases():
         "smooth_closed_form",), 30
     ball = ns.model("bouncing_ball")
     yield "bouncing_ball", ball.preset("period_one"), ("smooth", "exact"), 30  # with sticking
-    yield "bouncing_ball chaotic", ball.preset("chaotic"), ("smooth", "exact"), 4  # Gamma = 3
+    yield "bouncing_ball chaotic", ball.preset("chaotic"), ("smooth", "exact"), 4  # Gamma = 3, r = 0.85
     yield "two_sided", ns.model("two_sided").params(), ("smooth", "exact"), 8  # chaotic
     yield "two_sided closed form", ns.model("two_sided").params(F0=0.6, omega=1.3), (
         "smooth_closed_form",), 20  # period 1, both supports

@@ -67,8 +67,8 @@ def component_pair(pair, names, field: str) -> tuple | None:
     except TypeError:
         parts = []
     if len(parts) != 2:
-        raise ParameterError(f"{field}: expected two state components (e.g. X,V), got "
-                             f"{pair!r}")
+        raise ParameterError(f"{field}: expected two state components (e.g. "
+                             f"{','.join(names[:2])}), got {pair!r}")
     for name in parts:
         if name not in names:
             raise ParameterError(f"{field}: unknown component {name!r} (the model has "

@@ -82,9 +82,16 @@ MODEL = model_from_equations(
     references=("P. J. Holmes, J. Sound Vib. 84 (1982) 173-189",
                 "J. M. Luck and A. Mehta, Phys. Rev. E 48 (1993) 3988-3997"),
     presets={
-        "period_one": ({"A": 1.3 / (4 * math.pi**2)}, "Gamma = 1.3: the stable period-one orbit"),
-        "doubled": ({"A": 1.7 / (4 * math.pi**2)}, "Gamma = 1.7: past the period doubling"),
-        "chaotic": ({"A": 3.0 / (4 * math.pi**2)}, "Gamma = 3.0"),
+        "period_one": ({"A": 1.3 / (4 * math.pi**2)},
+                       "Gamma = 1.3: the stable period-one orbit, one impact per period (from "
+                       "x0 = 0.07, v0 = -0.6; from rest the ball chatters and rides on the table "
+                       "once per period)"),
+        "doubled": ({"A": 1.6 / (4 * math.pi**2)},
+                    "Gamma = 1.6: the period-two orbit past the period doubling at Gamma = 1.527 "
+                    "(from x0 = 0.07, v0 = -0.6)"),
+        "chaotic": ({"A": 3.0 / (4 * math.pi**2), "r": 0.85},
+                    "Gamma = 3.0, r = 0.85: chaotic bouncing, lambda1 about 0.5 per period (at "
+                    "r = 0.5 the ball ends up chattering and riding on the table)"),
     },
 )
 _PARAM_NAMES["bouncing_ball"] = MODEL.param_names
