@@ -46,6 +46,8 @@ from scipy.integrate import solve_ivp
 import nonsmooth as ns
 from nonsmooth import kernels
 from nonsmooth.integrate.contract import MAX_GUARDS
+from nonsmooth.integrate.hybrid import _oscillator
+from nonsmooth.integrate.pwlinear import N_MC
 from nonsmooth.models import BUILTIN
 from nonsmooth.models._probe import call_guards, call_initial, call_linear, call_transition
 
@@ -135,10 +137,10 @@ def propagation(model, params, method) -> str:
     n = model.n
     fns, p, out = model.fns(method), params.pack(), np.zeros(max(4, n * n + 3 * n))
     modes = m.modes or tuple(range(len(model.mode_names)))
-    def kind(r):  # (as ``hybrid._mode_class``: a general row of the oscillator's form, or of
-        if r == 2 and n == 2 and out[0] == 0 and out[1] == 1 \
-                and out[4] == out[6] == out[8] == 0 and (  # free flight, is an oscillator)
-                    (out[2] < 0 and out[3] <= 0) or (out[2] == 0 and out[3] == 0)):
+    om = 2 * math.pi / params.period if params.period else None
+
+    def kind(r):  # a general row (2) of the oscillator's form takes its formulas, as in the kernel
+        if r == 2 and n == 2 and om and _oscillator(out, om, np.zeros(N_MC)):
             return "oscillator"
         return {1: "oscillator", 2: "series"}.get(r)
 

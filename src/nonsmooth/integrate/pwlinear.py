@@ -3,11 +3,13 @@ one-degree-of-freedom oscillators (building blocks of the exact event-driven ker
 
 A **mode** is the linear equation
 
-    X'' + c X' + k X = F0 cos(omega t) + b,      k > 0, c >= 0,
+    X'' + c X' + k X = F0 cos(omega t) + Fs sin(omega t) + b,      k > 0, c >= 0,
 
 whose solution is particular (constant b/k + harmonic P cos + Q sin) plus homogeneous
-u = (y, z) = exp(A s) u0 with A = [[0, 1], [-k, -c]]. The 2x2 exponential is written in closed
-form for the under-, critically and over-damped cases (``eval_state``), so one evaluation costs
+u = (y, z) = exp(A s) u0 with A = [[0, 1], [-k, -c]]; or free flight, k = c = 0
+(``KIND_FREE``), where the pair (y, z) also carries the constant force: y = y0 + z0 s + b s^2/2.
+The 2x2 exponential is written in closed form for the under-, critically and over-damped cases
+(``eval_state``; exp(A s) = I + A s in free flight), so one evaluation costs
 one ``exp`` and two small-angle (cos, sin) pairs (Taylor polynomials, no libm call, for angles
 up to 0.5 rad). The coefficients of a mode are one row of a float64 array (``mode_coeffs``);
 a model is a set of such rows plus its switching rules, so the same machinery serves any
@@ -50,7 +52,7 @@ MC_XS = 3      # static offset b / k
 MC_P = 4       # particular solution P cos(omega t) + Q sin(omega t)
 MC_Q = 5
 MC_A = 6       # -c / 2 (real part of the eigenvalues)
-MC_KIND = 7    # KIND_UNDER / KIND_CRIT / KIND_OVER
+MC_KIND = 7    # KIND_UNDER / KIND_CRIT / KIND_OVER / KIND_FREE
 MC_NU = 8      # damped frequency (under) or mu = sqrt(c^2/4 - k) (over)
 MC_SQK = 9     # sqrt(k)
 MC_LMAX = 10   # longest piece tried in this mode
