@@ -69,7 +69,8 @@ MODEL = model_from_equations(
                    "contact": ["V", f"{FLIGHT} - k_c*Z - 2*{ZETA}*sqrt(k_c)*V"]},
             guards={"flight": [("Z", "contact")], "contact": [("-Z", "flight")]},
             initial=[("Z < 0", "contact")],
-            description="compliant table (spring-damper restituting r), RKF45"),
+            description="compliant table (spring-damper restituting r); flight and contact in "
+                        "closed form"),
     },
     description="a ball bouncing on a harmonically vibrating table (relative height Z)",
     forcing_amplitude="A",

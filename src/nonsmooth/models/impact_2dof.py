@@ -84,7 +84,8 @@ MODEL = model_from_equations(
             guards={"free": [("delta - X", "contact")], "contact": [("X - delta", "free")]},
             initial=[("X > delta", "contact")],
             flow_is_homeomorphism=True,
-            description="compliant stop (spring-damper restituting about r), RKF45"),
+            description="compliant stop (spring-damper restituting about r); both modes in "
+                        "closed form"),
     },
     description="two masses in series, the primary one hitting a rigid stop",
     forcing_amplitude="F0",
