@@ -435,24 +435,28 @@ def test_free_flight_does_not_miss_a_brief_visit_past_a_surface():
     np.testing.assert_allclose(ds.X.values[after], expect, rtol=0, atol=1e-9 * (1 + t[-1] ** 2))
 
 
+@pytest.mark.parametrize("forcing", ["sin", "cos"])
 @pytest.mark.parametrize("k, b", [(1e-8, -0.1), (1.3 ** 2 * (1 + 1e-7), 0.0)])
-def test_an_ill_conditioned_row_keeps_the_series(k, b):
+def test_an_ill_conditioned_row_keeps_the_series(k, b, forcing):
     """A weak spring with a constant force (b / k = 1e7) and a mode near resonance: the
     oscillator's formulas would cancel large terms (X to 1e-7 and 4e-9 only), so these rows
-    stay on the series (``hybrid.OSC_COND``), exact to round-off: X against the closed form
-    in 40 digits (mpmath) to 1e-12. (Found by a review of 6fd7526.)"""
+    go to the series (``hybrid._conditioned``), exact to round-off, whether the mode is a
+    general row (forced in sin) or the oscillator's (k, c, b, F) row (forced in cos): X
+    against the closed form in 40 digits (mpmath) to 1e-12. (Found by a review of 6fd7526.)"""
     import mpmath as mp
-    om, Fs = 1.3, 0.3
+    om, F0 = 1.3, 0.3
     m = ns.model_from_equations(
-        "ill_conditioned_row", states=("X", "V"), parameters={"k": k, "b": b, "Fs": Fs,
+        "ill_conditioned_row", states=("X", "V"), parameters={"k": k, "b": b, "F0": F0,
                                                               "omega": om},
-        modes={"m": ["V", "-k*X + b + Fs*sin(omega*t)"]}, method="exact")
+        modes={"m": ["V", f"-k*X + b + F0*{forcing}(omega*t)"]}, method="exact")
     ds = ns.simulate(m.params(), periods=2, method="exact", x0=0.0, v0=0.5,
                      samples_per_period=50)
     with mp.workdps(40):
-        K, B, F, W = mp.mpf(k), mp.mpf(b), mp.mpf(Fs), mp.mpf(om)
-        s, Q = mp.sqrt(K), F / (K - W * W)
-        c1, c2 = -B / K, (mp.mpf(0.5) - Q * W) / s
-        ref = [float(B / K + Q * mp.sin(W * t) + c1 * mp.cos(s * t) + c2 * mp.sin(s * t))
+        K, B, F, W = mp.mpf(k), mp.mpf(b), mp.mpf(F0), mp.mpf(om)
+        s, amp = mp.sqrt(K), F / (K - W * W)  # the particular amp sin (or cos) of omega t
+        harm = mp.sin if forcing == "sin" else mp.cos
+        c1 = -B / K - (amp if forcing == "cos" else 0)
+        c2 = (mp.mpf(0.5) - (amp * W if forcing == "sin" else 0)) / s
+        ref = [float(B / K + amp * harm(W * t) + c1 * mp.cos(s * t) + c2 * mp.sin(s * t))
                for t in ds.t.values]
     assert np.max(np.abs(ds.X.values - np.array(ref))) < 1e-12

@@ -520,9 +520,27 @@ def frame_omega(pp, opts):
     return f
 
 
-#: a general row takes the oscillator's formulas only where they are well conditioned
-#: (``_oscillator``); elsewhere the series
+#: the oscillator's formulas are used only where they are well conditioned (``_conditioned``);
+#: elsewhere the series
 OSC_COND = 1e-3
+
+
+@nb.njit(cache=True)
+def _conditioned(k, c, b, forced, om):
+    """Whether the oscillator's formulas (k > 0, c >= 0) keep the state to about
+    eps / OSC_COND: False for a constant force on a weak spring, k < OSC_COND max(om^2,
+    c^2 / 4) (the static offset b / k and the slow homogeneous part cancel: a loss of about
+    eps |b| / k); an over-damped mode with k < OSC_COND c^2 / 4 (its slow rate
+    -c / 2 + sqrt(c^2 / 4 - k) cancels); a forced mode near resonance,
+    |k - om^2 + i c om| < OSC_COND max(k, om^2) (the particular harmonic and the homogeneous
+    part cancel: about eps F / |k - om^2 + i c om|)."""
+    om2 = om * om
+    d = k - om2
+    if b != 0.0 and k < OSC_COND * max(om2, 0.25 * c * c):
+        return False
+    if k < OSC_COND * 0.25 * c * c:
+        return False
+    return not (forced and d * d + (c * om) ** 2 < (OSC_COND * max(k, om2)) ** 2)
 
 
 @nb.njit(cache=True)
@@ -530,13 +548,9 @@ def _oscillator(lin, om, mc):
     """A general-form ``linear`` row (n = 2) that is the oscillator X' = V,
     V' = -k X - c V + b + f_c cos(omega t) + f_s sin(omega t) with k > 0 and c >= 0, or free
     flight (k = c = 0): fill its closed-form row ``mc`` (``pwlinear.mode_coeffs``) and return
-    True; False for any other form, and where the oscillator's formulas are ill-conditioned
-    (the series of ``linmodes``, exact to round-off, takes those): a weak spring,
-    k < OSC_COND max(om^2, c^2 / 4), whose static offset b / k and slow homogeneous part
-    cancel; a mode near resonance, |k - om^2 + i c om| < OSC_COND max(k, om^2), whose
-    particular harmonic and homogeneous part cancel (a loss of about eps / OSC_COND of the
-    state, against eps |b| / k and eps F / |k - om^2 + i c om| otherwise); an undamped mode
-    forced at resonance."""
+    True; False for any other form, where the oscillator's formulas are ill-conditioned
+    (``_conditioned``: the series of ``linmodes``, exact to round-off, takes those) and for an
+    undamped mode forced at resonance."""
     if not (lin[0] == 0.0 and lin[1] == 1.0 and lin[4] == 0.0 and lin[6] == 0.0
             and lin[8] == 0.0):
         return False
@@ -544,12 +558,25 @@ def _oscillator(lin, om, mc):
     c = -lin[3]
     if k == 0.0 and c == 0.0:
         return mode_coeffs(k, c, lin[5], lin[7], om, THETA, mc, lin[9])
-    om2 = om * om
-    d = k - om2
-    if not (k >= OSC_COND * max(om2, 0.25 * c * c) and c >= 0.0
-            and d * d + (c * om) ** 2 >= (OSC_COND * max(k, om2)) ** 2):
+    if not (k > 0.0 and c >= 0.0
+            and _conditioned(k, c, lin[5], lin[7] != 0.0 or lin[9] != 0.0, om)):
         return False
     return mode_coeffs(k, c, lin[5], lin[7], om, THETA, mc, lin[9])
+
+
+@nb.njit(cache=True)
+def _as_general_row(lin):
+    """The (k, c, b, F) row of the oscillator (``linear`` returned 1) rewritten in place as
+    the general row of the same mode (A = [[0, 1], [-k, -c]], b = (0, b), f_c = (0, F),
+    f_s = 0), for the series."""
+    k, c, b, F = lin[0], lin[1], lin[2], lin[3]
+    for i in range(10):
+        lin[i] = 0.0
+    lin[1] = 1.0
+    lin[2] = -k
+    lin[3] = -c
+    lin[5] = b
+    lin[7] = F
 
 
 @nb.njit(cache=True)
@@ -562,6 +589,11 @@ def _mode_class(linear, closed, mode, pp, lin, MC, mcs, om, MF, n, MXR, PW):
     if mcs[mode] == _MC_UNKNOWN:
         mcs[mode] = _MC_RK
         r = linear(mode, pp, lin)
+        if r == 1 and n == 2 and lin[0] > 0.0 and lin[1] >= 0.0 and not _conditioned(
+                lin[0], lin[1], lin[2], lin[3] != 0.0, om) and (
+                lin[0] - om * om) ** 2 + (lin[1] * om) ** 2 > 1e-300:
+            _as_general_row(lin)  # ill-conditioned (not at resonance: that stays a status)
+            r = 2
         if r == 1 and n == 2 and lin[0] > 0.0 and lin[1] >= 0.0:  # (the bounds need c >= 0)
             MF[mode] = lin[3]
             if mode_coeffs(lin[0], lin[1], lin[2], lin[3], om, THETA, MC[mode]):
