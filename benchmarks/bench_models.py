@@ -52,6 +52,10 @@ try:  # (a tree before 6fd7526, run side by side: general rows all on the series
     from nonsmooth.integrate.hybrid import _oscillator
 except ImportError:
     _oscillator = None
+try:  # (a tree before the drift's closed form)
+    from nonsmooth.integrate.hybrid import _drift
+except ImportError:
+    _drift = None
 from nonsmooth.models import BUILTIN
 from nonsmooth.models._probe import call_guards, call_initial, call_linear, call_transition
 
@@ -146,6 +150,8 @@ def propagation(model, params, method) -> str:
     def kind(r):  # a general row (2) of the oscillator's form takes its formulas, as in the kernel
         if r == 2 and n == 2 and om and _oscillator and _oscillator(out, om, np.zeros(N_MC)):
             return "oscillator"
+        if r == 2 and n == 2 and _drift and _drift(out):
+            return "drift"
         return {1: "oscillator", 2: "series"}.get(r)
 
     closed = [f"{model.mode_names[k]} ({w})" for k in modes

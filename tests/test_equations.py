@@ -460,3 +460,33 @@ def test_an_ill_conditioned_row_keeps_the_series(k, b, forcing):
         ref = [float(B / K + amp * harm(W * t) + c1 * mp.cos(s * t) + c2 * mp.sin(s * t))
                for t in ds.t.values]
     assert np.max(np.abs(ds.X.values - np.array(ref))) < 1e-12
+
+
+@pytest.mark.parametrize("v0", [0.05, 0.2])
+def test_a_drift_mode_takes_its_closed_form_and_does_not_miss_a_brief_dip(v0):
+    """A drift X' = w, V' = 0 (the stick phase of a mass on a belt) against a surface that
+    moves, g = c + a cos(omega t) - X: with c chosen so that g dips 1e-6 below zero for some
+    5e-3 near t = pi + asin(w / a), inside one piece (0.7 long), the reset X -> 0 must happen
+    at the first root of c + a cos(omega t) - w t, and again at the next. From V = w the drift
+    moves as force-free flight (``hybrid._MC_DRIFT``: the closed form); from V != w (X' is
+    then not V) it takes the series: both give the root-found solution to 1e-11."""
+    from scipy.optimize import brentq
+    a, w = 0.3, 0.05
+    tm = math.pi + math.asin(w / a)
+    c = -(a * math.cos(tm) - w * tm) - 1e-6
+    m = ns.model_from_equations(
+        "drift_dip", states=("X", "V"), parameters={"c": c, "a": a, "w": w, "omega": 1.0},
+        modes={"glide": ["w", "0"]},
+        guards={"glide": [("c + a*cos(omega*t) - X", [(True, "glide", {"X": "0"})])]},
+        method="exact")
+    ds = ns.simulate(m.params(), periods=2, method="exact", x0=0.0, v0=v0,
+                     samples_per_period=400)
+    g = lambda t, t0: c + a * math.cos(t) - w * (t - t0)  # noqa: E731
+    t1 = brentq(g, tm - 0.01, tm, args=(0.0,), xtol=1e-15)
+    grid = np.linspace(t1 + 1e-3, 4 * math.pi, 4000)  # the next root: the first sign change
+    i = np.flatnonzero(np.array([g(s, t1) for s in grid]) < 0)[0]
+    t2 = brentq(g, grid[i - 1], grid[i], args=(t1,), xtol=1e-15)
+    t = ds.t.values
+    expect = np.where(t < t1, w * t, np.where(t < t2, w * (t - t1), w * (t - t2)))
+    assert t2 < t[-1] and np.max(np.abs(ds.X.values - expect)) < 1e-11
+    assert np.all(ds.V.values == v0)

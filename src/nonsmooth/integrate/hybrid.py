@@ -105,7 +105,7 @@ from .contract import (  # noqa: E402
     ST_VA,
     ST_X,
 )
-from .pwlinear import (BD_D2, BD_D3, BD_D4, BD_R, EXCLUDED, HERM_ERR, MC_A,  # noqa: E402
+from .pwlinear import (BD_D2, BD_D3, BD_D4, BD_R, EXCLUDED, HERM_ERR, MC_A, MC_B,  # noqa: E402
                        MC_K, MC_LMAX, N_BD, N_MC, accel, apply_propagator, classify,
                        energy_norm, eval_state, functional_bounds, herm_clear, herm_coeffs,
                        hom_part, jerk, mode_coeffs, propagator)
@@ -135,6 +135,7 @@ _MC_CLOSED = 1
 _MC_RK = 2
 _MC_RESONANT = 3
 _MC_POLY = 4  # a linear mode of any dimension: the series of exp(M s) (``linmodes``)
+_MC_DRIFT = 5  # X' = b0, V' = 0 (A = 0): free flight without force while V = b0, else the series
 
 # log2(m) on [0.5, 1), least-squares quartic (same as rkf45.pow_fast)
 @nb.njit(cache=True, inline="always")
@@ -580,10 +581,32 @@ def _as_general_row(lin):
 
 
 @nb.njit(cache=True)
+def _drift(lin):
+    """A general-form ``linear`` row (n = 2) that is a drift at a constant rate, X' = b0 and
+    V' = 0 (A = 0, no forcing): a stick phase on a moving belt, a ball riding on its table."""
+    for i in range(10):
+        if i != 4 and lin[i] != 0.0:
+            return False
+    return True
+
+
+@nb.njit(cache=True, inline="always")
+def _paths(cls, ncv, v, MC, mode):
+    """(cf, pm): whether the mode's pieces take the closed form or the series. A drift
+    (``_MC_DRIFT``) whose state has V = b0 (kept in MC_B) moves exactly as free flight without
+    force (X' = V = b0, V' = 0), so it takes that closed form; with V != b0 (X' is then not V)
+    it takes the series. Curved guards keep a drift on the series."""
+    if cls == _MC_DRIFT:
+        d = ncv == 0 and v == MC[mode, MC_B]
+        return d, not d
+    return cls == _MC_CLOSED and ncv == 0, cls == _MC_POLY
+
+
+@nb.njit(cache=True)
 def _mode_class(linear, closed, mode, pp, lin, MC, mcs, om, MF, n, MXR, PW):
-    """_MC_CLOSED / _MC_RK / _MC_RESONANT / _MC_POLY for ``mode``, filling the table row (and
-    the forcing amplitude ``MF[mode]``, or the series' matrices M^j / j! ``PW[mode]`` of the
-    augmented matrix M and its rate ``MXR[mode]``) lazily."""
+    """_MC_CLOSED / _MC_RK / _MC_RESONANT / _MC_POLY / _MC_DRIFT for ``mode``, filling the
+    table row (and the forcing amplitude ``MF[mode]``, or the series' matrices M^j / j!
+    ``PW[mode]`` of the augmented matrix M and its rate ``MXR[mode]``; a drift gets both) lazily."""
     if not closed:
         return _MC_RK
     if mcs[mode] == _MC_UNKNOWN:
@@ -603,6 +626,13 @@ def _mode_class(linear, closed, mode, pp, lin, MC, mcs, om, MF, n, MXR, PW):
         elif r == 2 and n == 2 and _oscillator(lin, om, MC[mode]):
             MF[mode] = lin[7]
             mcs[mode] = _MC_CLOSED
+        elif r == 2 and n == 2 and _drift(lin):
+            MXR[mode] = lin_matrix(lin, n, om, PW[mode, :, 1])  # (the series: V != b0)
+            series_powers(n + 3, PW[mode])
+            mode_coeffs(0.0, 0.0, 0.0, 0.0, om, THETA, MC[mode])  # free flight, no force
+            MC[mode, MC_B] = lin[4]  # the drift rate b0 (MC_B is not read by ``pwlinear``)
+            MF[mode] = 0.0
+            mcs[mode] = _MC_DRIFT
         elif r == 2:
             MXR[mode] = lin_matrix(lin, n, om, PW[mode, :, 1])
             series_powers(n + 3, PW[mode])
@@ -1705,8 +1735,7 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
         _store(state, u, n, mem, nmem, mode, h)
         keep_alive(ws)
         return st.RESONANCE
-    cf = cls == _MC_CLOSED and ncv == 0
-    pm = cls == _MC_POLY
+    cf, pm = _paths(cls, ncv, u[1], MC, mode)
     if cf:
         _cf_bounds(MC, mode, om, G, ng, n, GB)
 
@@ -2004,7 +2033,8 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
                 errY2 = 0.0
                 if tan:
                     if cf:
-                        _cf_tangent(MC, mode, om, hs, Y, PT)
+                        if cls != _MC_DRIFT:  # (a drift's propagator is the identity)
+                            _cf_tangent(MC, mode, om, hs, Y, PT)
                     elif pm:
                         poly_tangent(PW[mode], n, hs, Y, PE, pt)
                     elif use8:
@@ -2120,8 +2150,7 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
                 if cls == _MC_RESONANT:
                     code = st.RESONANCE
                     break
-                cf = cls == _MC_CLOSED and ncv == 0
-                pm = cls == _MC_POLY
+                cf, pm = _paths(cls, ncv, u[1], MC, mode)
                 _deriv(cf, field, mode, tau, C, S, u, pp, mem, f0, MC, om)
                 if csec:  # the side after the reset: a jump across the surface is no
                     sgn = _section_side_curved(curved, mode, tau, G, ksec, H, n, u, f0, C, S,

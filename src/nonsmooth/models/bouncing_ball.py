@@ -11,8 +11,8 @@ above -g) ends a chattering sequence: the ball rides on the table (mode ``stuck`
 until the table's downward acceleration exceeds g, when it takes off again, so complete
 chattering ends in finite time, never Zeno. Free flight (no stiffness) and riding on the
 table are linear modes propagated in closed form: free flight by the oscillator's formulas
-with k = c = 0 (a parabola plus the table's harmonic, ``integrate.pwlinear``), riding by the
-series of the augmented matrix exponential (``integrate.linmodes``).
+with k = c = 0 (a parabola plus the table's harmonic, ``integrate.pwlinear``), riding as a
+drift at rate 0 (Z' = V = 0: the same formulas without force).
 
 ``method="smooth"``: the table is a stiff linear spring-damper, mode ``contact`` while Z < 0,
 force -k_c Z - c V with c = 2 zeta sqrt(k_c) and zeta = -ln r / sqrt(pi^2 + ln^2 r), so that
