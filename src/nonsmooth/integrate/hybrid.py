@@ -48,12 +48,14 @@ Design summary
   a located crossing is checked to be the first. So the answer does not depend on where outputs
   are taken (issue 20).
 * ``opts[OPT_CLOSED_FORM] == 1`` and n == 2: modes that ``linear`` declares
-  X'' + c X' + k X = F cos(omega t) + b (k > 0) are propagated in closed form
+  X'' + c X' + k X = F cos(omega t) + b (k > 0), or in the general form as that oscillator,
+  free flight or a drift X' = V = b0 (``_MC_DRIFT``), are propagated in closed form
   (:mod:`.pwlinear`) in pieces of at most THETA = 0.7 rad of their fastest oscillation; the
   same exit test is applied to the exact piece ends, the crossing is located by third-order
   Newton steps on the exact closed-form state, kept in the bracket (``_locate_cf``; Illinois
   after a few steps at a tangential touch), and interior extrema of X are refined by Halley's
-  method on V = 0, ended by a quadratic Taylor step (exact to round-off).
+  method on V = 0, ended by a quadratic Taylor step (exact to round-off), unless the bound of
+  X'''' shows they cannot move the interval's Xmax / Xmin (``_x_extrema_exact``).
   The propagator of a full piece is computed once per mode and call.
 * Work arrays are views into one workspace without reference counting (:mod:`.workspace`):
   numba would otherwise increment and decrement a reference count atomically for every array
@@ -105,10 +107,11 @@ from .contract import (  # noqa: E402
     ST_VA,
     ST_X,
 )
-from .pwlinear import (BD_D2, BD_D3, BD_D4, BD_R, EXCLUDED, HERM_ERR, MC_A, MC_B,  # noqa: E402
-                       MC_K, MC_LMAX, N_BD, N_MC, accel, apply_propagator, classify,
-                       energy_norm, eval_state, functional_bounds, herm_clear, herm_coeffs,
-                       hom_part, jerk, mode_coeffs, propagator)
+from .pwlinear import (BD_D2, BD_D3, BD_D4, BD_R, EXCLUDED, HERM_ERR, KIND_FREE,  # noqa: E402
+                       MC_A, MC_B, MC_C, MC_G, MC_K, MC_KIND, MC_LMAX, MC_P, MC_Q, N_BD, N_MC,
+                       accel, apply_propagator, classify, energy_norm, eval_state,
+                       functional_bounds, herm_clear, herm_coeffs, hom_part, jerk, mode_coeffs,
+                       propagator)
 from .linmodes import (N_TAYLOR, POLY_DEPTH, THETA_POLY, guard_poly, lin_matrix,  # noqa: E402
                        poly_component, poly_m4, poly_root, poly_state, poly_tangent, pval7,
                        pvalue, poly_x_extrema, pval, series_powers, taylor_terms)
@@ -272,14 +275,49 @@ def _rk_step(field, mode, tau, C, S, h, om, n, u, k0, pp, mem, rtol, atol, us, k
 _EXT_STEP = 1e-6
 
 
+@nb.njit(cache=True, inline="always")
+def _x4_bound(MC, m, om, y0, z0):
+    """A bound of |X''''| over a closed-form piece from the homogeneous part (y0, z0): the
+    dual energy norm of (1, 0) A^4 times sqrt(k y0^2 + z0^2) plus om^4 times the harmonic
+    amplitude (``pwlinear.functional_bounds`` for g = X; free flight: om^4 (|(P, Q)| + |b| /
+    om^2), its homogeneous part a parabola)."""
+    om4 = (om * om) * (om * om)
+    R = math.hypot(MC[m, MC_P], MC[m, MC_Q])
+    if MC[m, MC_KIND] == KIND_FREE:
+        return om4 * (R + abs(MC[m, MC_G]) / (om * om))
+    k = MC[m, MC_K]
+    c = MC[m, MC_C]
+    w1 = 1.0
+    w2 = 0.0
+    for _ in range(4):
+        w1, w2 = -k * w2, w1 - c * w2  # (w1, w2) <- (w1, w2) A
+    return math.sqrt(w1 * w1 / k + w2 * w2) * math.sqrt(k * y0 * y0 + z0 * z0) + om4 * R
+
+
 @nb.njit(cache=True)
 def _x_extrema_exact(MC, m, om, F, y0, z0, C, S, X, V, X1, V1, h, xmax, xmin):
     """Interior extrema of X on a closed-form piece of length h (F: the mode's forcing
     amplitude): first guesses from the cubic Hermite of X, then Halley's method on V(s) = 0
     with the exact state (V' = X'', V'' = X''' = ``pwlinear.jerk``), ended by a quadratic
-    Taylor step once the step is below ``_EXT_STEP`` h."""
+    Taylor step once the step is below ``_EXT_STEP`` h. Candidates that cannot move xmax or
+    xmin are not refined: X is within HERM_ERR h^4 max|X''''| of its Hermite on the piece, so
+    when every candidate's Hermite value lies that far inside [xmin, xmax] (the piece's ends
+    included), so does every value of X on the piece (a hop of a chattering ball lower than an
+    earlier one, a slip extremum inside the interval's range)."""
     a1, a2, a3 = herm_coeffs(X, V, X1, V1, h)
     q1, q2 = quad_roots01(a1, 2.0 * a2, 3.0 * a3)
+    if q1 <= 0.0 and q2 <= 0.0:
+        return xmax, xmin
+    err = HERM_ERR * (h * h) * (h * h) * _x4_bound(MC, m, om, y0, z0)
+    top = max(xmax, X, X1) - err
+    bot = min(xmin, X, X1) + err
+    inside = True
+    for q in (q1, q2):
+        if q > 0.0:
+            Hq = X + q * (a1 + q * (a2 + q * a3))
+            inside = inside and bot <= Hq <= top
+    if inside:
+        return xmax, xmin
     for q in (q1, q2):
         if q > 0.0:
             s = q * h
