@@ -390,17 +390,16 @@ def _g_full(cf, s, G, k, n, q0, q1, q2, q3, C, S, om, hs, MC, mode, y0, z0, F):
 def _guard_bounds(cf, G, k, n, q2, q3, om, hs, MC, mode, y0, z0, BD):
     """(M2, M3, M4): bounds of |g''|, |g'''|, |g''''| of guard k over the whole step. On a
     closed-form piece: the energy-norm bounds of the homogeneous part plus om^n times the
-    harmonic amplitudes (``pwlinear.functional_bounds``, into the scratch ``BD``); on an RKF45
-    step: the derivatives of the state's cubic plus om^n times the amplitude of the guard's
-    forcing terms."""
+    harmonic amplitudes (``pwlinear.functional_bounds``: ``BD`` is the guard's row of the
+    mode's table GB, ``_cf_bounds``); on an RKF45 step: the derivatives of the state's cubic
+    plus om^n times the amplitude of the guard's forcing terms (``BD`` unused)."""
     om2 = om * om
-    Rg = math.hypot(G[k, n + 1], G[k, n + 2])
-    if cf:
-        functional_bounds(MC[mode], om, G[k, 0], G[k, 1], BD)
+    if cf:  # BD: the guard's row of GB (``_cf_bounds``: the guard's forcing included)
         En = energy_norm(MC, mode, y0, z0)
-        R = BD[BD_R] + Rg
+        R = BD[BD_R]
         return (BD[BD_D2] * En + om2 * R, BD[BD_D3] * En + om2 * om * R,
                 BD[BD_D4] * En + om2 * om2 * R)
+    Rg = math.hypot(G[k, n + 1], G[k, n + 2])
     h2 = hs * hs
     return (max(abs(2.0 * q2), abs(2.0 * q2 + 6.0 * q3)) / h2 + om2 * Rg,
             6.0 * abs(q3) / (h2 * hs) + om2 * om * Rg, om2 * om2 * Rg)
@@ -1990,7 +1989,7 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
                                 or herm_clear(g0, d0, g1, d1, hs, M4)):
                             hi, ghi = _scan_step(cf, g0, d0, g1, d1, u, f0, u1, f1, C, S, C1, S1,
                                                  G, k, n, q0, q1, q2, q3, om, hs, MC, mode, y0,
-                                                 z0, MF[mode], stack, BD)
+                                                 z0, MF[mode], stack, GB[k])
                     if hi > 1.0:
                         continue
                     if hi > s_best:
@@ -2005,7 +2004,7 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
                     if cert and lo > 0.0:  # the first crossing, not a later one
                         lo, hi = _first_crossing(cf, lo, hi, g0, d0, u, f0, C, S, G, k, n, q0,
                                                  q1, q2, q3, om, hs, MC, mode, y0, z0, MF[mode],
-                                                 stack, BD)
+                                                 stack, GB[k])
                     if hi - lo > S_TOL:
                         code = st.EVENT_FAILED
                         break
@@ -2184,7 +2183,10 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
                     ng += 1
                     if csec:
                         ncv += 1
-                cls = _mode_class(linear, closed, mode, pp, lin, MC, mcs, om, MF, n, MXR, PW)
+                cls = int(mcs[mode])  # (known after the mode's first visit)
+                if cls == _MC_UNKNOWN:
+                    cls = _mode_class(linear, closed, mode, pp, lin, MC, mcs, om, MF, n, MXR,
+                                      PW)
                 if cls == _MC_RESONANT:
                     code = st.RESONANCE
                     break
