@@ -112,3 +112,26 @@ def test_model_helpers():
     assert model_lines(sup, "exact") == [(1.0, r"support $X = 1$")]
     assert len(model_lines(sup, "smooth")) == 3
     assert model_lines(sup, "smooth", band_edges=False) == [(1.0, r"support $X = 1$")]
+
+
+def test_a_user_models_figures_find_the_model_in_the_process_and_from_its_file(monkeypatch,
+                                                                               tmp_path):
+    """A result names its model by name only; a user's model is not built in, so figures drew
+    it with generic mode labels and without its lines (a newcomer's finding). In the process
+    that used it they now take that model (``models.used``); in another, the model loaded
+    from the file the result's ``model_source`` names; with that file gone, generic labels."""
+    from pathlib import Path
+
+    from nonsmooth import models
+    path = Path(__file__).resolve().parents[1] / "examples" / "one_sided_duffing.py"
+    m = ns.model(f"{path}:MODEL")
+    ds = ns.simulate(m.params(), periods=2, method="exact")
+    assert ds.attrs["model_source"] == f"{path}:MODEL"
+    assert model_of(ds) is m and mode_labels(model_of(ds)) == ("free", "contact")
+    assert model_lines(ds) == [(1.0, "support (X = gap)")]
+    monkeypatch.setattr(models, "_USED", {})  # as in a new process: from the file
+    assert model_of(ds).name == "one_sided_duffing"
+    assert model_lines(ds) == [(1.0, "support (X = gap)")]
+    monkeypatch.setattr(models, "_USED", {})
+    ds.attrs["model_source"] = f"{tmp_path / 'gone.py'}:MODEL"
+    assert model_of(ds) is None and model_lines(ds) == []

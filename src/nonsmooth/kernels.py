@@ -244,6 +244,8 @@ class Solver:
              "method": self.method, "rtol": float(o[OPT_RTOL]),
              "atol": float(o[OPT_ATOL]), "max_steps_per_period": int(self.max_steps),
              "section_phase": self.section_phase}
+        if self.model.source != "built-in":  # a user's file (``path.py:NAME``): figures load it
+            a["model_source"] = self.model.source
         if self.code == KERNEL_SUPPORT_SMOOTH:
             a["integrator"] = smooth_integrator()
         elif self.code == KERNEL_SUPPORT_EXACT:

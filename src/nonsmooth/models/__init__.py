@@ -30,6 +30,16 @@ __all__ = ["Model", "Method", "Param", "ModelParams", "param_index", "model", "m
 
 _USER: dict = {}
 
+#: the models this process has used (a ``Model`` given to ``model``, or loaded from a file),
+#: by name: a result names its model only by name, and a figure drawn in the same process
+#: finds a user's model here (``used``)
+_USED: dict = {}
+
+
+def used(name: str):
+    """The model called ``name`` that this process used last (``model``), or None."""
+    return _USED.get(name)
+
 
 def models() -> tuple:
     """Names of the built-in models."""
@@ -40,6 +50,7 @@ def model(name) -> Model:
     """The model called ``name`` (built-in), or ``"path/to/file.py:NAME"`` (a ``Model`` named
     ``NAME``, default ``MODEL``, defined in a user's script), or a ``Model`` itself."""
     if isinstance(name, Model):
+        _USED[name.name] = name
         return name
     if not isinstance(name, str) or not name:
         raise ParameterError(f"model: expected a model name, got {name!r}")
@@ -47,7 +58,9 @@ def model(name) -> Model:
         return importlib.import_module(BUILTIN[name]).MODEL
     path, attr = _split_source(name)
     if path.endswith(".py"):
-        return _load_user(path, attr or "MODEL")
+        m = _load_user(path, attr or "MODEL")
+        _USED[m.name] = m
+        return m
     raise ParameterError(f"model: unknown model {name!r} (built-in: {', '.join(BUILTIN)}; or "
                          f"path/to/file.py:NAME for your own)")
 

@@ -38,14 +38,24 @@ def model_name(ds) -> str:
 
 def model_of(ds):
     """The :class:`~nonsmooth.models.base.Model` named in the dataset (``support`` for files
-    without a ``model`` attribute), or None when it cannot be loaded (e.g. a user model whose
-    file is gone): figures then fall back to generic mode labels and draw no model lines."""
+    without a ``model`` attribute): a built-in model, else a user's model that this process
+    used (``models.used``), else one loaded from the file its ``model_source`` attribute names;
+    None when it cannot be found (e.g. a user model whose file is gone): figures then fall
+    back to generic mode labels and draw no model lines."""
     from ..errors import ParameterError
-    from ..models import model
-    try:
-        return model(model_name(ds))
-    except ParameterError:
-        return None
+    from ..models import BUILTIN, model, used
+    name = model_name(ds)
+    if name not in BUILTIN and used(name) is not None:
+        return used(name)
+    source = getattr(ds, "attrs", ds).get("model_source")
+    for spec in (name, source) if source else (name,):
+        try:
+            m = model(spec)
+        except Exception:  # noqa: BLE001 - a missing or broken file: no model, generic labels
+            continue
+        if m.name == name:
+            return m
+    return None
 
 
 def mode_colors(m, n=None) -> tuple:
