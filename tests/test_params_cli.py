@@ -135,6 +135,8 @@ def _cli(*args, cwd=None):
     (["--periods", "0"], "periods:"),
     (["-o", "/nonexistent-dir/x.nc"], "output: cannot write"),
     (["--plot", "/nonexistent-dir/x.png"], "plot: cannot write"),
+    (["--nope"], "No such option: --nope"),  # click's usage errors: one line too (a newcomer
+    (["--periods", "abc"], "Invalid value for '--periods'"),  # saw typer's 5-line box)
 ])
 def test_simulate_bad_input_one_line_nonzero_no_traceback(args, needle, tmp_path):
     argv = ["simulate", *args]

@@ -68,6 +68,12 @@ def _resume_notice(path, done: int, total: int) -> None:
     typer.echo(f"resuming from {path}: {done} of {total} chunks already done", err=True)
 
 
+#: click's exception classes as typer raises them (typer vendors click since 0.2x: found by
+#: name among the bases of its public ``BadParameter``)
+_USAGE_ERROR, _CLICK_EXCEPTION = (next(c for c in typer.BadParameter.__mro__ if c.__name__ == n)
+                                  for n in ("UsageError", "ClickException"))
+
+
 def main(argv: list[str] | None = None) -> None:
     from .. import chunks
     planned.clear()
@@ -80,7 +86,21 @@ def main(argv: list[str] | None = None) -> None:
         if any(a == "--transition" or a.startswith("--transition=") for a in args):
             raise ParameterError("transition: the option is gone; eq. 12 is the support model's "
                                  "method: --method smooth_eq12 (eq. 13 is --method smooth)")
-        app(args=args, prog_name="nonsmooth")
+        rv = app(args=args, prog_name="nonsmooth", standalone_mode=False)
+        sys.exit(rv if isinstance(rv, int) else 0)
+    except _USAGE_ERROR as exc:  # an unknown option or command, a value of the wrong type
+        if type(exc).__name__ != "NoArgsIsHelpError":  # (typer has shown the help then)
+            # one line, like every other bad input
+            ctx = getattr(exc, "ctx", None)
+            where = f" (see '{ctx.command_path} --help')" if ctx is not None else ""
+            typer.echo(f"error: {exc.format_message()}{where}", err=True)
+        sys.exit(EXIT_USAGE)
+    except typer.Abort:  # (what click's standalone mode prints)
+        typer.echo("Aborted!", err=True)
+        sys.exit(1)
+    except _CLICK_EXCEPTION as exc:
+        typer.echo(f"error: {exc.format_message()}", err=True)
+        sys.exit(exc.exit_code)
     except Interrupted as exc:
         typer.echo(interrupted_message(exc.code), err=True)
         sys.exit(exc.code)

@@ -45,8 +45,9 @@ kernel never re-triggers the switch at the same instant (this is what keeps the 
 whose slip acceleration vanishes at the breakaway point, and grazing returns free of ZENO
 loops). For v_s = 0 the slip modes are linear (k = omega0^2, c = xi, b = -/+ mu_k, F = F0)
 and propagated in closed form (except undamped at omega = omega0, where the kernel's closed
-form has no bounded particular solution); for v_s > 0 they are integrated by the RKF45 at
-rtol 1e-12, atol 1e-14.
+form has no bounded particular solution); for v_s > 0 they are integrated by DOP853 at
+rtol 1e-12, atol 1e-14 (the kernel's steps below rtol 1e-10). The stick mode, a drift
+X' = V = v_belt, is propagated in closed form too.
 
 Both methods merge trajectories in stick (``flow_is_homeomorphism=False``). An orbit counts as
 "sticking" when the stick mode was visited.
@@ -355,8 +356,8 @@ MODEL = Model(
                         exact_initial, exact_linear, closed_form=True,
                         modes=(SLIP_F, SLIP_B, STICK), flow_is_homeomorphism=False,
                         rtol=1e-12, atol=1e-14,
-                        description="event-driven stick/slip: closed form in Coulomb slip, "
-                                    "exact stick, RKF45 (rtol 1e-12) in Stribeck slip"),
+                        description="event-driven stick/slip: closed form in stick and "
+                                    "Coulomb slip, DOP853 (rtol 1e-12) in Stribeck slip"),
     },
     n_memory=N_MEMORY,
     references=("R. I. Leine, D. H. van Campen, A. de Kraker, L. van den Steen, Stick-slip "
