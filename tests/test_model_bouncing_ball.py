@@ -80,3 +80,19 @@ def test_chatter_ends_in_sticking_not_zeno():
     assert int(ds.regions_visited) & 0b10  # stuck on the table at some time
     assert float(ds.min_X) >= -1e-12  # never below the table
     assert float(ds.max_X) > 1e-3  # and launched again
+
+
+def test_a_start_on_the_table_moving_into_it_bounces_at_once():
+    """From Z = 0 with V = -0.3 (far faster than the sticking threshold) the exact method
+    applies the impact at t = 0 (V -> 0.15) and flies: Z = 0.15 t - g t^2 / 2 + A omega t -
+    A sin(omega t). It used to classify the start as riding on the table, keeping V = -0.3 (a
+    review's finding)."""
+    import math
+    p = ns.model("bouncing_ball").preset("period_one")
+    ds = ns.simulate(p, periods=1, method="exact", x0=0.0, v0=-0.3, samples_per_period=200)
+    g, w, A = 1.0, 2 * math.pi, 1.3 / (4 * math.pi ** 2)
+    t = ds.t.values[1:20]
+    Z = 0.15 * t - g * t ** 2 / 2 + A * w * t - A * np.sin(w * t)
+    V = 0.15 - g * t + A * w * (1 - np.cos(w * t))
+    assert np.max(np.abs(ds.X.values[1:20] - Z)) < 1e-12
+    assert np.max(np.abs(ds.V.values[1:20] - V)) < 1e-12

@@ -92,6 +92,22 @@ def test_periodic_orbit_of_the_stribeck_case_is_the_true_period_4_orbit():
     assert float(orb.multiplier_abs[0]) == pytest.approx(0.3245, abs=5e-4)
 
 
+def test_periodic_orbit_does_not_report_a_stick_state_off_the_belt_as_an_orbit():
+    """Newton's steps moved V off v_belt while the section state kept the stick mode, whose
+    drift (X' = v_belt, V' = 0) keeps any V: a fixed point of that artefact was reported
+    'converged' and 'stable' for k = 1 (a review's finding; the independent solver maps that
+    point to (-0.848, -0.056), not to itself). It is now 'not confirmed', naming the state;
+    k = 4 still finds the true orbit (|mu_1| = 0.32452069 against the independent solver's
+    finite difference)."""
+    p = ns.model("stick_slip").params(**STRIBECK)
+    orb = ns.periodic_orbit(p, transient=60, method="exact", samples_per_period=50)
+    assert orb.attrs["status"].startswith("not confirmed: its section state has V = ")
+    assert "'stick'" in orb.attrs["status"] and orb.attrs["converged"] == 0
+    orb = ns.periodic_orbit(p, k=4, transient=60, method="exact", samples_per_period=50)
+    assert orb.attrs["status"] == "converged"
+    assert float(orb.multiplier_abs[0]) == pytest.approx(0.32452069, abs=1e-7)
+
+
 def test_periodic_orbit_reports_an_orbit_that_does_not_close_when_integrated_again(monkeypatch):
     monkeypatch.setattr(stability, "CONFIRM_TOL", 0.0)  # nothing closes exactly
     p = ns.model("stick_slip").params(**STRIBECK)

@@ -211,6 +211,33 @@ def _section_state(setup, p, z, template):
     return s
 
 
+def _off_its_drift(setup, p, s) -> str:
+    """Why the section state ``s`` cannot carry its mode, or "": a mode whose ``linear`` row
+    is a drift X' = b0, V' = 0 (stick on a belt, a ball riding on its table) holds V = b0. A
+    state with another V that the model itself puts in another mode (``initial``) is an
+    artefact of Newton's steps (the mode carried over while V moved), not a point of an orbit:
+    integrated, such a state keeps its V while X drifts."""
+    from ..integrate.contract import OPT_NMEM, OPT_PHASE, ST_EXTRA, ST_V, ST_X
+    from ..integrate.hybrid import _drift
+    from ..models._probe import call_initial, call_linear
+    spec = setup.solver.spec
+    mode = int(s[ST_MODE])
+    if not spec.closed_form or spec.linear is None or setup.n != 2 or mode < 0:
+        return ""
+    row = np.zeros(10)
+    if call_linear(setup.fns, mode, p, row) != 2 or not _drift(row) or s[ST_V] == row[4]:
+        return ""
+    nm = int(setup.opts[OPT_NMEM])
+    mem = np.array(s[ST_EXTRA:ST_EXTRA + nm], dtype=np.float64) if nm else np.zeros(1)
+    psi = float(setup.opts[OPT_PHASE])
+    u = np.array([s[ST_X], s[ST_V]], dtype=np.float64)
+    if call_initial(setup.fns, math.cos(psi), math.sin(psi), u, p, mem) == mode:
+        return ""
+    return (f"its section state has V = {s[ST_V]:.6g} in mode "
+            f"{setup.model.mode_names[mode]!r}, whose drift holds V = {row[4]:.6g} (a state "
+            f"the model puts in another mode: not a point of an orbit)")
+
+
 def periodic_orbit(params, *, k: int = 1, x0: float = 0.0, v0: float = 0.0,
                    method: str = "exact", transient: int = 0, tol: float = 1e-10,
                    max_iter: int = 40, rtol: float = 1e-10, atol: float = 1e-12,
@@ -332,6 +359,10 @@ def periodic_orbit(params, *, k: int = 1, x0: float = 0.0, v0: float = 0.0,
     if converged and not confirm <= CONFIRM_TOL * (1.0 + float(np.linalg.norm(z))):
         status = (f"not confirmed: integrated again at {spp} samples per period, the orbit "
                   f"misses its start by {confirm:.3g}")
+        converged = False
+    why = _off_its_drift(setup, p, start) if converged else ""
+    if why:
+        status = f"not confirmed: {why}"
         converged = False
     X = np.concatenate([[start[0]], Xs])
     V = np.concatenate([[start[1]], Vs])

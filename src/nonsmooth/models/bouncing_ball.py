@@ -60,7 +60,9 @@ MODEL = model_from_equations(
                                             {"Z": "0", "V": "0"}),
                                            (True, "flight", {"Z": "0", "V": "-r*V"})])],
                     "stuck": [Guard("g - A*omega**2*sin(omega*t)", "flight")]},
-            initial=[(f"Z <= 0 and V <= 0 and {PRESSING}", "stuck")],
+            # (a faster start into the table is an impact: flight, whose guard applies it)
+            initial=[(f"Z <= 0 and V <= 0 and -V < {V_STICK}*g/omega and {PRESSING}",
+                      "stuck")],
             admissible="Z >= 0",
             description="Newton's impact law, chatter ending in sticking; flight in closed "
                         "form"),

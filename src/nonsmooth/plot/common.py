@@ -42,7 +42,6 @@ def model_of(ds):
     used (``models.used``), else one loaded from the file its ``model_source`` attribute names;
     None when it cannot be found (e.g. a user model whose file is gone): figures then fall
     back to generic mode labels and draw no model lines."""
-    from ..errors import ParameterError
     from ..models import BUILTIN, model, used
     name = model_name(ds)
     if name not in BUILTIN and used(name) is not None:
