@@ -163,3 +163,13 @@ def test_from_attrs_refuses_a_swept_parameter_left_at_its_base_value():
         ns.model("support").params_from_attrs(attrs)
     with pytest.raises(ns.ParameterError, match="^nope: not a parameter of model 'support'"):
         ns.model("support").params_from_attrs(ds, nope=1.0)
+
+
+def test_an_output_below_a_file_names_the_file_as_not_a_folder(tmp_path):
+    """`-o afile/x.nc` with `afile` a file said "directory 'afile' does not exist" (a
+    newcomer's finding); a missing folder still says it does not exist."""
+    (tmp_path / "afile").write_text("")
+    with pytest.raises(ns.errors.OutputError, match="afile' is a file, not a directory$"):
+        io.check_writable(tmp_path / "afile" / "x.nc")
+    with pytest.raises(ns.errors.OutputError, match="does not exist$"):
+        io.check_writable(tmp_path / "nope" / "x.nc")

@@ -93,7 +93,8 @@ def check_writable(path, what: str = "output") -> Path:
     if p.is_dir():
         raise OutputError(f"{what}: {str(p)!r} is a directory")
     if not parent.is_dir():
-        raise OutputError(f"{what}: cannot write {str(p)!r}: directory {str(parent)!r} does not exist")
+        why = "is a file, not a directory" if parent.exists() else "does not exist"
+        raise OutputError(f"{what}: cannot write {str(p)!r}: {str(parent)!r} {why}")
     if not os.access(parent, os.W_OK) or (p.exists() and not os.access(p, os.W_OK)):
         raise OutputError(f"{what}: cannot write {str(p)!r}: permission denied")
     return p
