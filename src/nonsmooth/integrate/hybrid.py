@@ -107,8 +107,8 @@ from .contract import (  # noqa: E402
     ST_VA,
     ST_X,
 )
-from .pwlinear import (BD_D2, BD_D3, BD_D4, BD_R, EXCLUDED, HERM_ERR, KIND_FREE,  # noqa: E402
-                       MC_A, MC_B, MC_C, MC_G, MC_K, MC_KIND, MC_LMAX, MC_P, MC_Q, N_BD, N_MC,
+from .pwlinear import (BD_D2, BD_D3, BD_D4, BD_R, EXCLUDED, HERM_ERR, MC_A,  # noqa: E402
+                       MC_B, MC_K, MC_LMAX, N_BD, N_MC,
                        accel, apply_propagator, classify, energy_norm, eval_state,
                        functional_bounds, herm_clear, herm_coeffs, hom_part, jerk, mode_coeffs,
                        propagator)
@@ -275,32 +275,14 @@ def _rk_step(field, mode, tau, C, S, h, om, n, u, k0, pp, mem, rtol, atol, us, k
 _EXT_STEP = 1e-6
 
 
-@nb.njit(cache=True, inline="always")
-def _x4_bound(MC, m, om, y0, z0):
-    """A bound of |X''''| over a closed-form piece from the homogeneous part (y0, z0): the
-    dual energy norm of (1, 0) A^4 times sqrt(k y0^2 + z0^2) plus om^4 times the harmonic
-    amplitude (``pwlinear.functional_bounds`` for g = X; free flight: om^4 (|(P, Q)| + |b| /
-    om^2), its homogeneous part a parabola)."""
-    om4 = (om * om) * (om * om)
-    R = math.hypot(MC[m, MC_P], MC[m, MC_Q])
-    if MC[m, MC_KIND] == KIND_FREE:
-        return om4 * (R + abs(MC[m, MC_G]) / (om * om))
-    k = MC[m, MC_K]
-    c = MC[m, MC_C]
-    w1 = 1.0
-    w2 = 0.0
-    for _ in range(4):
-        w1, w2 = -k * w2, w1 - c * w2  # (w1, w2) <- (w1, w2) A
-    return math.sqrt(w1 * w1 / k + w2 * w2) * math.sqrt(k * y0 * y0 + z0 * z0) + om4 * R
-
-
 @nb.njit(cache=True)
-def _x_extrema_exact(MC, m, om, F, y0, z0, C, S, X, V, X1, V1, h, xmax, xmin):
+def _x_extrema_exact(MC, m, om, F, y0, z0, C, S, X, V, X1, V1, h, xmax, xmin, BD):
     """Interior extrema of X on a closed-form piece of length h (F: the mode's forcing
     amplitude): first guesses from the cubic Hermite of X, then Halley's method on V(s) = 0
     with the exact state (V' = X'', V'' = X''' = ``pwlinear.jerk``), ended by a quadratic
     Taylor step once the step is below ``_EXT_STEP`` h. Candidates that cannot move xmax or
-    xmin are not refined: X is within HERM_ERR h^4 max|X''''| of its Hermite on the piece, so
+    xmin are not refined: X is within HERM_ERR h^4 max|X''''| of its Hermite on the piece
+    (the bound of ``pwlinear.functional_bounds`` for g = X, into the scratch ``BD``), so
     when every candidate's Hermite value lies that far inside [xmin, xmax] (the piece's ends
     included), so does every value of X on the piece (a hop of a chattering ball lower than an
     earlier one, a slip extremum inside the interval's range)."""
@@ -308,7 +290,10 @@ def _x_extrema_exact(MC, m, om, F, y0, z0, C, S, X, V, X1, V1, h, xmax, xmin):
     q1, q2 = quad_roots01(a1, 2.0 * a2, 3.0 * a3)
     if q1 <= 0.0 and q2 <= 0.0:
         return xmax, xmin
-    err = HERM_ERR * (h * h) * (h * h) * _x4_bound(MC, m, om, y0, z0)
+    functional_bounds(MC[m], om, 1.0, 0.0, BD)
+    om2 = om * om
+    M4 = BD[BD_D4] * energy_norm(MC, m, y0, z0) + om2 * om2 * BD[BD_R]
+    err = HERM_ERR * (h * h) * (h * h) * M4
     top = max(xmax, X, X1) - err
     bot = min(xmin, X, X1) + err
     inside = True
@@ -2097,7 +2082,7 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
                     pass  # (OPT_NO_EXTREMA: the outputs are not read)
                 elif cf:
                     xmax, xmin = _x_extrema_exact(MC, mode, om, MF[mode], y0, z0, C, S, u[0],
-                                                  u[1], u1[0], u1[1], hs, xmax, xmin)
+                                                  u[1], u1[0], u1[1], hs, xmax, xmin, BD)
                 elif pm:
                     xmax, xmin = poly_x_extrema(TW, hs, xmax, xmin, cp, MXR[mode])
                 elif pd:  # the DOP853 step's dense output, sampled as a series piece
