@@ -550,8 +550,8 @@ def test_series_primitives_against_exact_arithmetic():
     import scipy.linalg
 
     from nonsmooth.integrate.linmodes import (N_TAYLOR, THETA_POLY, lin_matrix, poly_m4,
-                                              poly_tangent, pval, pvalue, series_powers,
-                                              taylor_terms)
+                                              poly_tangent, propagate_state, pval, pvalue,
+                                              series_powers, series_propagator, taylor_terms)
     rng = np.random.default_rng(7)
     fact = np.array([float(math.factorial(j)) for j in range(N_TAYLOR + 1)])
     for _ in range(20):
@@ -588,19 +588,36 @@ def test_series_primitives_against_exact_arithmetic():
     u = rng.normal(size=n)
     C, S = math.cos(0.4), math.sin(0.4)
     TW = np.zeros((m, N_TAYLOR + 1))
-    taylor_terms(PW, n, u, C, S, TW)
+    taylor_terms(PW, n, u, C, S, TW, np.ones(m))
+    # only the rows asked for are written (the constant's always), each as when all are
+    for need in ([0.0, 1.0, 0.0, 0.0, 0.0, 0.0], [0.0, 1.0, 0.0, 0.0, 1.0, 0.0]):
+        TW1 = np.full((m, N_TAYLOR + 1), np.nan)
+        taylor_terms(PW, n, u, C, S, TW1, np.array(need))
+        assert np.array_equal(TW1[1], TW[1]) and np.isnan(TW1[0, 1:]).all() \
+            and np.isnan(TW1[2, 1:]).all() and np.array_equal(TW1[n], TW[n])
+        assert np.array_equal(TW1[n + 1:], TW[n + 1:]) if need[n + 1] \
+            else np.isnan(TW1[n + 1:, 1:]).all()
     z0 = np.concatenate([u, [1.0, C, S]])
     for s in (0.3 / rho, THETA_POLY / rho):  # up to a full piece
         want = scipy.linalg.expm(Mx.reshape(m, m) * s) @ z0
         got = np.array([pvalue(TW[i], s) for i in range(m)])
         assert np.max(np.abs(got - want)) < 1e-13 * np.abs(want).max()
         assert abs(got[n + 1] - math.cos(0.4 + om * s)) < 1e-14  # the forcing rows rotate
-        # the tangent: exp(A s) on the state rows, memory rows left alone
+        # the end of a piece from exp(M s)'s state rows (``series_propagator``)
+        E = np.zeros((n, m))
+        series_propagator(PW, n, s, E)
+        u1 = np.zeros(n)
+        propagate_state(E, n, u, C, S, u1)
+        assert np.max(np.abs(u1 - want[:n])) < 1e-13 * np.abs(want).max()
+        # the tangent: exp(A s) on the state rows, memory rows left alone; from E the same
         Y = rng.normal(size=(n + 1, 2))
         want_Y = Y.copy()
         want_Y[:n] = scipy.linalg.expm(A * s) @ Y[:n]
-        poly_tangent(PW, n, s, Y, np.zeros((n, n)), np.zeros(n))
+        Y2 = Y.copy()
+        poly_tangent(PW, n, s, Y, np.zeros((n, n)), np.zeros(n), False)
         assert np.max(np.abs(Y - want_Y)) < 1e-13 * np.abs(want_Y).max()
+        poly_tangent(PW, n, s, Y2, E, np.zeros(n), True)
+        assert np.array_equal(Y2, Y)
 
 
 def test_series_root_and_extrema_against_closed_forms():
@@ -648,7 +665,7 @@ def test_series_root_and_extrema_against_closed_forms():
             t = mp.mpf(t)
             return v0 + A * om * mC - g * t - A * om * mp.cos(mph + om * t)
 
-        taylor_terms(PW, n, np.array([z0, v0]), C, S, TW)
+        taylor_terms(PW, n, np.array([z0, v0]), C, S, TW, np.ones(n + 3))
         guard_poly(G, 0, n, TW, cp)
         # the first sign change of Z on a geometric grid, then the closed form's root
         ts = np.geomspace(1e-9, hs, 2001)

@@ -114,7 +114,8 @@ from .pwlinear import (BD_D2, BD_D3, BD_D4, BD_R, EXCLUDED, HERM_ERR, MC_A,  # n
                        propagator)
 from .linmodes import (N_TAYLOR, POLY_DEPTH, THETA_POLY, guard_poly, lin_matrix,  # noqa: E402
                        poly_component, poly_m4, poly_root, poly_state, poly_tangent, pval7,
-                       pvalue, poly_x_extrema, pval, series_powers, taylor_terms)
+                       propagate_state, pvalue, poly_x_extrema, pval, series_powers,
+                       series_propagator, taylor_terms)
 from .record import record_interval  # noqa: E402
 from .roots import illinois_point, illinois_update, quad_roots01  # noqa: E402
 from .rkstep import (_A, _B, _C, _E, _FM, _NS, _control, _cubic, _shrink,  # noqa: E402
@@ -791,8 +792,8 @@ def _g_eval(kind, s, cp, curved, mode, k, tau, C, S, hs, om, n, u, f0, u1, f1, p
     """(g, dg/dt) of guard k at the fraction s of the step: kind 0, an affine guard on a
     series piece (``cp``: its polynomial in time, ``linmodes.guard_poly``); kind 1, a curved
     guard (``_curved_at``)."""
-    if kind == 0:
-        return pval(cp, s * hs)
+    if kind == 0:  # (at s = 0 the polynomial's first two terms, which ``pval`` returns there)
+        return (cp[0], cp[1]) if s == 0.0 else pval(cp, s * hs)
     return _curved_at(curved, mode, k, tau, C, S, hs, om, n, u, f0, u1, f1, pp, mem, gr, us, s,
                       pm, TW)
 
@@ -921,6 +922,22 @@ def _guard_exit(kind, cp, curved, mode, k, tau, C, S, hs, om, n, u, f0, u1, f1, 
             break
         lo, hi, ghi = a2, b2, g2
     return lo, hi
+
+
+@nb.njit(cache=True)
+def _series_rows(G, ng, n, ncv, no_ext, need):
+    """need[i] = 1 for the rows of z = (u, 1, C, S) whose Taylor terms a full series piece of
+    the mode reads: X (row 0) for its extrema, unless they are not read; the components and
+    forcing terms of its affine guards (the section's row too); every row when a guard is
+    curved (evaluated on the whole state). The constant's row is always written."""
+    for i in range(n + 3):
+        need[i] = 1.0 if (ncv > 0 or (i == 0 and not no_ext) or i == n) else 0.0
+    for k in range(ng):
+        for i in range(n + 3):
+            if G[k, i] != 0.0:
+                need[i] = 1.0
+    if need[n + 2] != 0.0:
+        need[n + 1] = 1.0  # (the forcing pair: one flag, need[n + 1])
 
 
 @nb.njit(cache=True)
@@ -1609,7 +1626,8 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
              N_BD * (1 + MAX_GUARDS), (SCAN_DEPTH + 1) * 5, N_STAGES8 * nt * mt, 6 * nt + nt * nj,
              _NS * nt * nj if nt == 2 or nt == 4 else 0,
              2 * nme if tan else 0, len(cmi), mt, n + 1,
-             MAX_MODES + (N_TAYLOR + 1) * (m3 + 1) + n * n + n + 2 * MAX_GUARDS)
+             MAX_MODES + (N_TAYLOR + 1) * (m3 + 1) + n * n + n
+             + MAX_MODES * (n * m3 + 1) + 2 * m3 + 2 * MAX_GUARDS)
     total = 0
     for z in sizes:
         total += z
@@ -1673,6 +1691,13 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
     PE = view(ws, o, (n, n))  # exp(A h) of a series piece, for the tangent
     pt = view(ws, o + n * n, (n,))
     o += n * n + n
+    PF = view(ws, o, (MAX_MODES, n, m3))  # exp(M L) of a full series piece, state rows
+    o += MAX_MODES * n * m3
+    PFR = view(ws, o, (MAX_MODES,))  # 1: PF[mode] computed
+    o += MAX_MODES
+    need = view(ws, o, (m3,))  # the rows of the Taylor terms a full series piece needs
+    ALL = view(ws, o + m3, (m3,))  # every row (a piece cut short, retaken, the last)
+    o += 2 * m3
     # each affine guard's g and g' at the step's end, which are those at the next step's start
     # while ``gv`` (an accepted step without a switch in a mode whose guards are all affine and
     # not a series piece's: the state, its derivative and the phase are copied from the end)
@@ -1682,6 +1707,7 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
     if o + 2 * MAX_GUARDS != total:  # the views above and ``sizes`` must agree (views are not
         return st.NON_FINITE  # bounds-checked); a mismatch is a bug of this function (tests)
     pp[:] = p
+    ALL[:] = 1.0
     Y = unowned(Y)  # owned by the caller for the whole call
     L_out = unowned(L_out)
     cmi = unowned(cmi)
@@ -1752,6 +1778,7 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
             sgn = _section_side(G, ng, H, n, u, f0, C0, S0, om)
         ksec = ng
         ng += 1
+    _series_rows(G, ng, n, ncv, no_ext, need)
     cls = _mode_class(linear, closed, mode, pp, lin, MC, mcs, om, MF, n, MXR, PW)
     if cls == _MC_RESONANT:
         _store(state, u, n, mem, nmem, mode, h)
@@ -1770,6 +1797,7 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
     n_tiny = 0
     t_switch = -1e300
     gv = False
+    tw_all = True
     j = 0
     for it in range(n_total):
         j += 1
@@ -1826,8 +1854,15 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
                     Lm = THETA_POLY / MXR[mode]
                     last = Lm >= rem
                     hs = rem if last else Lm
-                    taylor_terms(PW[mode], n, u, C, S, TW)
-                    poly_state(TW, n, hs, u1)
+                    tw_all = last
+                    taylor_terms(PW[mode], n, u, C, S, TW, ALL if last else need)
+                    if last:
+                        poly_state(TW, n, hs, u1)
+                    else:  # a full piece: its end from exp(M L), the same every time
+                        if PFR[mode] == 0.0:
+                            series_propagator(PW[mode], n, Lm, PF[mode])
+                            PFR[mode] = 1.0
+                        propagate_state(PF[mode], n, u, C, S, u1)
                     C1, S1 = _rotate(C, S, om * hs)
                     if not _finite(u1, n):
                         code = st.NON_FINITE
@@ -2014,6 +2049,9 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
                         if cf:
                             C1, S1 = _cf_state(MC, mode, om, y0, z0, C, S, hs, u1, f1)
                         else:
+                            if pm and not tw_all:  # (the rows a full piece did not need)
+                                taylor_terms(PW[mode], n, u, C, S, TW, ALL)
+                                tw_all = True
                             err2, C1, S1 = _retake(field, pm, mode, tau, C, S, hs, om, n, u, f0,
                                                    pp, mem, rtol, atol, us, k1, k2, k3, k4, k5,
                                                    u1, f1, TW, use8, K8)
@@ -2058,7 +2096,10 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
                         if cls != _MC_DRIFT:  # (a drift's propagator is the identity)
                             _cf_tangent(MC, mode, om, hs, Y, PT)
                     elif pm:
-                        poly_tangent(PW[mode], n, hs, Y, PE, pt)
+                        if PFR[mode] == 1.0 and hs == THETA_POLY / MXR[mode]:  # a full piece
+                            poly_tangent(PW[mode], n, hs, Y, PF[mode], pt, True)
+                        else:
+                            poly_tangent(PW[mode], n, hs, Y, PE, pt, False)
                     elif use8:
                         errY2 = rk8_tangent(jacobian, mode, tau, C, S, hs, om, n, u, K8, pp, mem,
                                             Y, W, KY, J, us, cmi, rtol, atol)
@@ -2182,6 +2223,7 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
                                                pp, mem, gr)  # crossing
                 elif has_sec:
                     sgn = _section_side(G, ksec, H, n, u, f0, C, S, om)
+                _series_rows(G, ng, n, ncv, no_ext, need)  # (the section's row written)
                 if cf:
                     _cf_bounds(MC, mode, om, G, ng, n, GB)
                 if tan and not label and not _saltation(

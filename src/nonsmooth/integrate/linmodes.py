@@ -108,9 +108,13 @@ def series_powers(m, PW):
 
 
 @nb.njit(cache=True, fastmath={"contract"})
-def taylor_terms(PW, n, u, C, S, TW):
+def taylor_terms(PW, n, u, C, S, TW, need):
     """TW[:, j] = M^j z0 / j! (j = 0..N_TAYLOR) for z0 = (u, 1, C, S), from the matrices
-    PW[:, j] = M^j / j! (``series_powers``): TW[i] holds component i's N_TAYLOR + 1 terms.
+    PW[:, j] = M^j / j! (``series_powers``): TW[i] holds component i's N_TAYLOR + 1 terms,
+    for the rows i of z with ``need[i]`` != 0 (n + 3 flags; the constant's row is always
+    written, the forcing pair's with need[n + 1]; the others are not written: a piece whose
+    end comes from ``series_propagator`` needs only the rows its guards and the extrema of X
+    read; each row is computed the same way whichever others are).
     Four terms at a time, each summed in registers over the row (forcing columns first, then
     the state's), on contiguous rows of PW; the sums read u, C and S, not TW[:, 0], which may
     alias them. The augmented rows are known in form: the constant's is 0 beyond j = 0 (M's
@@ -123,6 +127,8 @@ def taylor_terms(PW, n, u, C, S, TW):
     TW[n + 1, 0] = C
     TW[n + 2, 0] = S
     for i in range(n):
+        if need[i] == 0.0:
+            continue
         r = i * m
         t = TW[i]
         a = PW[r + n]
@@ -148,6 +154,9 @@ def taylor_terms(PW, n, u, C, S, TW):
     rs = (n + 2) * m
     for j in range(1, N_TAYLOR + 1):
         TW[n, j] = 0.0
+    if need[n + 1] == 0.0:
+        return
+    for j in range(1, N_TAYLOR + 1):
         TW[n + 1, j] = PW[rc + n + 1, j] * C + PW[rc + n + 2, j] * S
         TW[n + 2, j] = PW[rs + n + 1, j] * C + PW[rs + n + 2, j] * S
 
@@ -275,15 +284,40 @@ def poly_x_extrema(TW, hs, xmax, xmin, cv, rho):
 
 
 @nb.njit(cache=True, fastmath={"contract", "reassoc"})
-def poly_tangent(PW, n, h, Y, E, t):
-    """Y[0:n] <- exp(A h) Y[0:n] (the homogeneous part; memory rows unchanged): E = exp(A h) =
-    sum_j h^j PW[:, j][:n, :n] (the top-left block of M^j / j! is A^j / j!; ``pvalue`` per
-    entry, on its row of PW), then each column multiplied by it; E (n x n) and t (n): work
-    arrays."""
+def series_propagator(PW, n, h, E):
+    """E[i, q] = exp(M h)[i, q] for the state rows i < n and every column q < n + 3 of the
+    augmented matrix (``pvalue`` per entry on its row of PW, as ``poly_tangent``): the state
+    at the end of a piece of length h is then u(h) = E z0, z0 = (u, 1, C, S), and E[:, :n] is
+    the tangent's exp(A h) (bit for bit: the same sums under the same flags). Computed once
+    per mode and call for the full piece."""
     m = n + 3
     for a in range(n):
-        for b in range(n):
+        for b in range(m):
             E[a, b] = pvalue(PW[a * m + b], h)
+
+
+@nb.njit(cache=True, inline="always")
+def propagate_state(E, n, u, C, S, out):
+    """out[0:n] = E z0 with z0 = (u, 1, C, S) (``series_propagator``'s E: a full piece)."""
+    for a in range(n):
+        acc = E[a, n] + E[a, n + 1] * C + E[a, n + 2] * S
+        for b in range(n):
+            acc += E[a, b] * u[b]
+        out[a] = acc
+
+
+@nb.njit(cache=True, fastmath={"contract", "reassoc"})
+def poly_tangent(PW, n, h, Y, E, t, ready):
+    """Y[0:n] <- exp(A h) Y[0:n] (the homogeneous part; memory rows unchanged): E = exp(A h) =
+    sum_j h^j PW[:, j][:n, :n] (the top-left block of M^j / j! is A^j / j!; ``pvalue`` per
+    entry, on its row of PW), then each column multiplied by it; E (n x n or wider) and t (n):
+    work arrays. With ``ready`` E already holds exp(A h) (``series_propagator``'s, a full
+    piece: the same values)."""
+    m = n + 3
+    if not ready:
+        for a in range(n):
+            for b in range(n):
+                E[a, b] = pvalue(PW[a * m + b], h)
     for col in range(Y.shape[1]):
         for a in range(n):
             acc = 0.0

@@ -63,7 +63,8 @@ FUNCTIONS = ("sin", "cos", "tan", "exp", "log", "sqrt", "sinh", "cosh", "tanh", 
              "atan", "atan2", "Abs", "sign", "Min", "Max", "floor", "Piecewise")
 SMOOTH_STEPS = ("logistic", "softplus")
 #: Tolerances an ``exact`` method enforces where a mode has no closed form (as the built-in
-#: models do): its RKF45 pieces are then accurate to round-off, not to the solver's rtol.
+#: models do): its pieces (DOP853 at this rtol) are then accurate to round-off, not to the
+#: solver's rtol.
 EXACT_RTOL, EXACT_ATOL = 1e-12, 1e-14
 #: Names the generated code uses itself: a state or parameter may not take them.
 _RESERVED = {"t", "pi", *FUNCTIONS, *SMOOTH_STEPS}  # (the generated code renames the rest)
@@ -374,7 +375,7 @@ def _derive(sp, ctx, name, mname, spec, states, pnames, mode_names, closed_form,
     rtol, atol = spec.get("rtol"), spec.get("atol")
     if mname == "exact" and rtol is None and atol is None \
             and not all(m in linear for m in own):
-        rtol, atol = EXACT_RTOL, EXACT_ATOL  # nonlinear modes of an exact method: RKF45, tight
+        rtol, atol = EXACT_RTOL, EXACT_ATOL  # nonlinear modes of an exact method: DOP853, tight
     return {"source": source, "closed_form": bool(linear), "continuous_memory": cm,
             "curved": any(not isinstance(r, list) for rs in rows.values() for r in rs),
             "flow_is_homeomorphism": bool(spec.get("flow_is_homeomorphism", False)),

@@ -21,7 +21,7 @@ it whirls):
 (g = X^2 + Y^2 - delta^2 >= 0), switched at the located crossing of the circle; the contact
 force is continuous there, its Jacobian is not (the saltation matrix is the identity, the
 tangent dynamics change field). The free whirl is linear: in closed form (the series of
-``integrate.linmodes``); the rub by RKF45 at rtol 1e-12.
+``integrate.linmodes``); the rub by DOP853 at rtol 1e-12 (``integrate.rk8``).
 
 ``method="smooth"``: one vector field, the contact force regularised over a band eta:
 k_s (r - delta)_+ is replaced by k_s eta softplus((r - delta) / eta), which tends to the exact
@@ -80,7 +80,7 @@ MODEL = model_from_equations(
             initial=[("X**2 + Y**2 > delta**2", "rub")],
             flow_is_homeomorphism=True,
             description="rub on the stator switched at the located crossing of the circle "
-                        "r = delta (a curved guard); free whirl in closed form, rub RKF45 at "
+                        "r = delta (a curved guard); free whirl in closed form, rub DOP853 at "
                         "rtol 1e-12"),
         "smooth": dict(
             modes={m: ["V", f"{FREE_X} - {SMOOTH_PRESS}*(X - mu*Y)",
