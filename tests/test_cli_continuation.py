@@ -31,7 +31,8 @@ def test_continue_writes_the_api_result_and_a_figure(tmp_path, capsys, branch):
     assert got.attrs["method"] == "exact" and got.attrs["status"] == branch.attrs["status"]
     assert png.read_bytes()[:4] == PNG
     lam = branch.omega.values
-    assert out.startswith(f"fig6a (exact): period-1 branch in omega, {lam.size} points")
+    assert out.startswith(f"fig6a with omega=0.5 (exact): period-1 branch in omega, "
+                          f"{lam.size} points")
     assert f"status: {branch.attrs['status']}" in out
     # the Fig. 6a resonance curve: grazing omega_a, folds omega_c and omega_b
     for needle in ("grazing (G)", "fold (F)", "0.940308", "1.193042", "1.055140"):

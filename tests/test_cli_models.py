@@ -52,7 +52,7 @@ def test_simulate_another_builtin_model(tmp_path):
     r = _cli("simulate", "--model", "stick_slip", "--set", "v_belt=0.3", "--periods", "2",
              "--samples-per-period", "20", "-o", "s.nc", cwd=tmp_path)
     assert r.returncode == 0, r.stderr
-    assert r.stdout.startswith("stick_slip (defaults): 2 periods")
+    assert r.stdout.startswith("stick_slip (defaults) with v_belt=0.3: 2 periods")
     ds = load_dataset(tmp_path / "s.nc")
     assert ds.attrs["model"] == "stick_slip" and ds.attrs["param_v_belt"] == 0.3
     assert ds.sizes["t"] == 41

@@ -37,7 +37,7 @@ def test_lyapunov_command_writes_the_api_result_and_a_figure(tmp_path, capsys):
     assert got.attrs["preset"] == "table3" and got.attrs["verdict"] == ds.attrs["verdict"]
     assert got.attrs["periods"] == 200 and got.attrs["method"] == "smooth"
     assert png.read_bytes()[:4] == PNG
-    assert out.startswith("table3 (smooth): 200 periods after 50")
+    assert out.startswith("table3 with omega=0.92 (smooth): 200 periods after 50")
     assert f"{float(ds.exponent[0]):+.6g}" in out and f"{float(ds.exponent_sum):+.6g}" in out
     assert f"verdict: {ds.attrs['verdict']}" in out
     assert out.splitlines()[-2:] == [f"wrote {nc}", f"wrote {png}"]

@@ -177,6 +177,10 @@ def test_simulate_command_writes_netcdf_and_png(tmp_path):
     assert r.returncode == 0, r.stderr
     ds = load_dataset(tmp_path / "t.nc")
     assert ds.attrs["param_omega"] == 5.2 and ds.attrs["preset"] == "table1"
+    # the summary line and the file say what --set changed in the preset (a newcomer's report:
+    # "table1" alone read as the preset's own omega)
+    assert ds.attrs["preset_changes"] == "omega=5.2"
+    assert r.stdout.startswith("table1 with omega=5.2: 2 periods after 5")
     assert ds.sizes["t"] == 201
     assert (tmp_path / "t.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
 

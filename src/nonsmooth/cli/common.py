@@ -122,14 +122,35 @@ def _assignments(items, m) -> dict:
     return out
 
 
-def preset_label(params, preset: str | None, default_preset: str | None = None) -> str:
-    """What the outputs call the parameter set: the preset (``model/preset`` for a model other
-    than the paper's), or ``model (defaults)``."""
+def _number(v) -> str:
+    return f"{v:.10g}" if isinstance(v, float) else str(v)
+
+
+class PresetLabel(str):
+    """The parameter set as the command's summary line names it: the preset, then what
+    ``--set`` changed in it ("table3 with omega=0.92"). ``name`` is the preset alone (the
+    result file's ``preset`` attribute), ``changes`` the changed values ("omega=0.92", the
+    ``preset_changes`` attribute; empty without ``--set``)."""
+
+    def __new__(cls, name: str, changes: str = ""):
+        self = super().__new__(cls, f"{name} with {changes}" if changes else name)
+        self.name = name
+        self.changes = changes
+        return self
+
+
+def preset_label(params, preset: str | None, default_preset: str | None = None) -> PresetLabel:
+    """What the outputs call the parameter set ``params`` (from :func:`load_params`): the
+    preset (``model/preset`` for a model other than the paper's), or ``model (defaults)``,
+    with the values ``--set`` changed in it (:class:`PresetLabel`)."""
     m = params.model
     preset = preset or _default_preset(m, default_preset)
+    base = m.preset(preset) if preset is not None else m.params()
+    changes = ", ".join(f"{k}={_number(getattr(params, k))}" for k in m.param_names
+                        if getattr(params, k) != getattr(base, k))
     if preset and m.name == DEFAULT_MODEL and m.source == "built-in":
-        return preset
-    return f"{m.name}/{preset}" if preset else f"{m.name} (defaults)"
+        return PresetLabel(preset, changes)
+    return PresetLabel(f"{m.name}/{preset}" if preset else f"{m.name} (defaults)", changes)
 
 
 def resolve_method(params, method: str | None) -> str:
@@ -168,12 +189,14 @@ def chunk_store(out: Path | None, dask: str | None = None):
 
 def save_outputs(ds, preset: str, out: Path | None, plot: Path | None, figure=None,
                  store=None) -> None:
-    """Record the preset, write the netCDF file and render ``figure(ds)`` (a plot function:
+    """Record the preset (and what ``--set`` changed in it), write the netCDF file and render ``figure(ds)`` (a plot function:
     Dataset in, Figure out) to ``plot`` where asked (each file written atomically). Once the
     result file is written, this run's chunk ``store`` (:func:`chunk_store`) is removed."""
     from ..io import save_dataset, save_figure
 
-    ds.attrs["preset"] = preset
+    ds.attrs["preset"] = getattr(preset, "name", preset)
+    if getattr(preset, "changes", ""):
+        ds.attrs["preset_changes"] = preset.changes
     if out is not None:
         save_dataset(ds, out)
         if store is not None:
