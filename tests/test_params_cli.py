@@ -135,6 +135,8 @@ def _cli(*args, cwd=None):
     (["--periods", "0"], "periods:"),
     (["-o", "/nonexistent-dir/x.nc"], "output: cannot write"),
     (["--plot", "/nonexistent-dir/x.png"], "plot: cannot write"),
+    (["-o", "x.png"], "a result is a netCDF file, give a name ending in .nc (a figure: --plot)"),
+    (["-o", "x.txt"], "'x.txt': a result is a netCDF file"),  # (it wrote netCDF in x.txt)
     (["--nope"], "No such option: --nope"),  # click's usage errors: one line too (a newcomer
     (["--periods", "abc"], "Invalid value for '--periods'"),  # saw typer's 5-line box)
 ])
