@@ -203,9 +203,10 @@ def chunk_store(out: Path | None, dask: str | None = None):
 
 def save_outputs(ds, preset: str, out: Path | None, plot: Path | None, figure=None,
                  store=None) -> None:
-    """Record the preset (and what ``--set`` changed in it), write the netCDF file and render ``figure(ds)`` (a plot function:
-    Dataset in, Figure out) to ``plot`` where asked (each file written atomically). Once the
-    result file is written, this run's chunk ``store`` (:func:`chunk_store`) is removed."""
+    """Record the preset (and what ``--set`` changed in it), write the netCDF file and render
+    ``figure(ds)`` (a plot function: Dataset in, Figure out) to ``plot`` where asked (each
+    file written atomically). Once the result file is written, this run's chunk ``store``
+    (:func:`chunk_store`) is removed."""
     from ..io import save_dataset, save_figure
 
     ds.attrs["preset"] = getattr(preset, "name", preset)
