@@ -15,7 +15,11 @@ z(s) = sum_j w_j s^j with w_j = M^j z0 / j!, and N_TAYLOR = 28 terms leave a rem
 term, 3^3 / 3! = 4.5, sets the round-off of the sum). The state is then a polynomial in s
 known to round-off, and so is every affine guard: g(s) = sum_j (G_k . w_j) s^j (a guard row
 is a row over z). Its derivative bounds follow from the coefficients (``poly_m4``), so the
-exit test is certified (``hybrid._guard_exit``).
+exit test is certified (``hybrid._guard_exit``). A full piece (length L) ends at u(L) = E z0,
+E = exp(M L)'s state rows computed once per mode and call (``series_propagator``; its left
+block is the tangent's exp(A L)), and its Taylor terms are computed only for the rows that
+its guards and the extrema of X read (``taylor_terms``' ``need``); a piece cut short by an
+event, retaken, or ending an output interval takes every row and sums them at its length.
 
 A model declares such a mode through ``linear(mode, p, out) -> 2`` with ``out[0:n*n]`` = A
 (row-major), then b, f_c, f_s (n each); see ``models.base``.
