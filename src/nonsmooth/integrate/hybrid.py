@@ -1531,6 +1531,8 @@ def _saltation(transition, mode, k, tau, C, S, om, n, ue, me, fm, gk, gdot, new_
             continue
         eps = 1e-7 * scale / dn
         ok_side = 0
+        cw = math.cos(om * eps * tw)  # the phase's rotation by om e tw, e = +-eps (cos is
+        sp = math.sin(om * eps * tw)  # even and sin odd, bit for bit)
         for side in (1.0, -1.0):
             e = side * eps
             for i in range(n):
@@ -1539,8 +1541,7 @@ def _saltation(transition, mode, k, tau, C, S, om, n, ue, me, fm, gk, gdot, new_
                 mc[i] = me[i]
             for q in range(ncm):
                 mc[cmi[q]] += e * Y[n + q, c]
-            cw = math.cos(om * e * tw)
-            sw = math.sin(om * e * tw)
+            sw = side * sp
             got = transition(mode, k, tau + e * tw, C * cw - S * sw, S * cw + C * sw, uc, pp, mc)
             if side > 0.0:
                 for i in range(n):
