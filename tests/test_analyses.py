@@ -231,6 +231,17 @@ def test_cli_poincare_and_resonance_write_outputs(tmp_path, capsys):
     assert (tmp_path / "p.nc").stat().st_size > 0 and (tmp_path / "p.png").stat().st_size > 0
     ds = ns.io.load_dataset(tmp_path / "p.nc")
     assert ds["period"] == 3 and ds.attrs["preset"] == "table3"
+    # a point without a period: its summary line gives the verdict and lambda1 of its file
+    try:
+        main(["poincare", "--set", "omega=0.92", "--record", "300", "--transient", "50",
+              "-o", str(tmp_path / "c.nc")])
+    except SystemExit as e:
+        assert e.code in (0, None)
+    out = capsys.readouterr().out
+    ds = ns.io.load_dataset(tmp_path / "c.nc")
+    assert int(ds.motion) == 3  # chaotic
+    assert out.startswith("table3 with omega=0.92: not periodic (period 0): chaotic (lambda1 = "
+                          f"{float(ds.lambda1):.3g} 1/s), contact 1")
 
 
 def _oscillator_and_passenger(k2):

@@ -128,9 +128,19 @@ def poincare_cmd(
                       progress=prog)
     from ..plot.poincare import plot_poincare
     save_outputs(ds, preset, out, plot, lambda d: plot_poincare(d, show=pair))
-    typer.echo(f"{preset}: {period_text(int(ds.period))}, contact {int(ds.contact)}, "
-               f"max X = {float(ds.max_X):.6g}, min X = {float(ds.min_X):.6g}")
+    typer.echo(f"{preset}: {period_text(int(ds.period))}{motion_text(ds)}, contact "
+               f"{int(ds.contact)}, max X = {float(ds.max_X):.6g}, min X = {float(ds.min_X):.6g}")
     echo_written(out, plot)
+
+
+def motion_text(ds) -> str:
+    """', chaotic (lambda1 = 0.0633 1/s)' for a non-periodic point whose result has the motion
+    verdict and lambda1 (a periodic one says nothing more than its period)."""
+    if "motion" not in ds or int(ds.period) > 0:
+        return ""
+    word = ds.motion.attrs["flag_meanings"].split()[int(ds.motion)].replace("_", "-")
+    lam = f" (lambda1 = {float(ds.lambda1):.3g} 1/s)" if "lambda1" in ds else ""
+    return f": {word}{lam}"
 
 
 @app.command("bifurcation")

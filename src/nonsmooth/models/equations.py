@@ -382,7 +382,8 @@ def _derive(sp, ctx, name, mname, spec, states, pnames, mode_names, closed_form,
             "modes": [mode_names.index(m) for m in own],
             "rtol": None if rtol is None else float(rtol),
             "atol": None if atol is None else float(atol),
-            "description": spec.get("description") or f"written as equations ({len(own)} modes)",
+            "description": spec.get("description")
+            or f"written as equations ({len(own)} mode{'' if len(own) == 1 else 's'})",
             "admissible": None if text is None else str(text)}
 
 
