@@ -187,6 +187,16 @@ def test_plots_return_figures():
     f = plot_poincare(poincare(p, record=20, transient=50, orbit_samples=20))
     assert f.axes[0].get_xlabel() == "$X = x/g$"
     plt.close(f)
+    # a period-1 map: its points agree to round-off; the axes show them at the orbit's scale
+    # (they zoomed into the round-off, with offsets like 1e-12 + 0.8929966938)
+    d1 = poincare(ns.preset("table3").replace(omega=1.1), record=20, transient=200,
+                  orbit_samples=50)
+    f = plot_poincare(d1)
+    lo, hi = f.axes[1].get_xlim()
+    ext = float(d1.orbit_X.max() - d1.orbit_X.min())
+    assert int(d1.period) == 1 and abs((hi - lo) - 0.1 * ext) < 1e-12 * ext
+    assert lo < float(d1.X.mean()) < hi and "(all within" in f.axes[1].get_title()
+    plt.close(f)
     b = bifurcation_diagram(p, "omega", [0.9, 0.91], transient=5, record=5)
     f = plot_bifurcation(b)
     assert "omega" in f.axes[0].get_xlabel() and len(f.axes[0].collections) >= 2

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import numpy as np
 
 from .common import (draw_model_lines, model_of, new_figure, param_title, scatter_by_region,
                      shown_components)
@@ -41,10 +42,32 @@ def plot_poincare(ds, show=None):
     names = str(ds.attrs.get("state_names", "X V")).split()
     ax1.set_xlabel(r"$X(kT)$" if ia == 0 else f"${names[ia]}(kT)$")
     ax1.set_ylabel(r"$V(kT)$" if ib == 1 else f"${names[ib]}(kT)$")
-    ax1.set_title(f"(b) Poincaré map, {n} points after {ds.attrs.get('transient', '?')} periods",
-                  fontsize=10)
+    title = f"(b) Poincaré map, {n} points after {ds.attrs.get('transient', '?')} periods"
+    spread = _zoom_out(ax1, X, V, oX, oV)
+    if spread is not None:
+        title += f" (all within {spread:.1g})"
+    ax1.set_title(title, fontsize=10)
     for ax in (ax0, ax1):
         ax.grid(True, lw=0.3, alpha=0.5)
     fig.suptitle(f"{ds.attrs.get('method', '')}: {param_title(ds)}", fontsize=9)
     fig.tight_layout()
     return fig
+
+
+def _zoom_out(ax, X, V, oX, oV, rel=1e-6):
+    """Where the section points coincide to ``rel`` of the orbit's extent (a periodic orbit:
+    they differ by round-off), centre the map's axes on them with 5 % of the orbit's extent
+    either side, instead of letting the axes zoom into the round-off; returns the points'
+    largest spread then (else None)."""
+    X, V = np.asarray(X, float), np.asarray(V, float)
+    ok = np.isfinite(X) & np.isfinite(V)
+    if not ok.any():
+        return None
+    X, V = X[ok], V[ok]
+    spans = [float(np.ptp(a)) for a in (X, V)]
+    extents = [float(np.nanmax(o) - np.nanmin(o)) if np.size(o) else 0.0 for o in (oX, oV)]
+    if not all(e > 0.0 and sp <= rel * e for sp, e in zip(spans, extents)):
+        return None
+    ax.set_xlim(float(X.mean()) - 0.05 * extents[0], float(X.mean()) + 0.05 * extents[0])
+    ax.set_ylim(float(V.mean()) - 0.05 * extents[1], float(V.mean()) + 0.05 * extents[1])
+    return max(spans)
