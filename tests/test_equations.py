@@ -490,3 +490,30 @@ def test_a_drift_mode_takes_its_closed_form_and_does_not_miss_a_brief_dip(v0):
     expect = np.where(t < t1, w * t, np.where(t < t2, w * (t - t1), w * (t - t2)))
     assert t2 < t[-1] and np.max(np.abs(ds.X.values - expect)) < 1e-11
     assert np.all(ds.V.values == v0)
+
+
+def test_a_method_knows_the_parameters_it_does_not_read(tmp_path):
+    """``Method.unused`` of a model written as equations: the parameters none of the method's
+    expressions reads (the forcing frequency always counts as read), the same when the
+    derivation comes from the cache; a figure's title leaves them out."""
+    import matplotlib
+    matplotlib.use("Agg")
+    from nonsmooth.plot.common import param_title
+
+    def build():
+        return ns.model_from_equations(
+            "unused_probe", states=("X", "V"),
+            parameters={"F0": 0.5, "omega": 1.3, "k_c": 100.0, "r": 0.8, "spare": 2.0},
+            methods={
+                "exact": dict(modes={"free": ["V", "F0*cos(omega*t) - X - 0.1*V"]},
+                              guards={"free": [ns.Guard("1 - X", "free", {"V": "-r*V"})]}),
+                "smooth": dict(modes={"free": ["V", "F0*cos(omega*t) - X - 0.1*V"],
+                                      "contact": ["V", "F0*cos(omega*t) - X - 0.1*V "
+                                                  "- k_c*(X - 1)"]},
+                               guards={"free": [("1 - X", "contact")],
+                                       "contact": [("X - 1", "free")]})})
+    for m in (build(), build()):  # (the second from the derivation's cache)
+        assert m.methods["exact"].unused == ("k_c", "spare")
+        assert m.methods["smooth"].unused == ("r", "spare")
+    ds = ns.simulate(m.params(), periods=2, method="exact")
+    assert param_title(ds) == "F0=0.5, omega=1.3, r=0.8"

@@ -81,8 +81,12 @@ def test_poincare_uses_the_model(results, name, method):
     visited = sorted(set(np.asarray(ds.orbit_region.values).tolist()))
     assert all(labels[c] in texts for c in visited)
     assert bool(_vlines_at(fig.axes[0], 1.0)) == (name == "support")
-    params = ", ".join(f"{k}=" for k in ns.model(name).param_names)
-    assert all(k in fig._suptitle.get_text() for k in params.split(", "))
+    m = ns.model(name)
+    title = fig._suptitle.get_text()
+    # every parameter the method reads, none it does not (the exact method's eta, k_c)
+    unused = m.methods[method].unused
+    assert all(f"{k}=" in title for k in m.param_names if k not in unused)
+    assert not any(f"{k}=" in title for k in unused)
 
 
 @pytest.mark.parametrize("name,method", CASES)

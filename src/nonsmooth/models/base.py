@@ -266,7 +266,9 @@ class Method:
     ``smooth_closed_form``: table3's bifurcation diagram's evidence in 0.09 s instead of the
     RKF45 tangent's 0.83 s). lambda1 is
     a property of the equations, not of the integrator; an explicit ``lyapunov_spectrum``
-    or ``floquet`` keeps the method asked for."""
+    or ``floquet`` keeps the method asked for. ``unused``: the parameters this method does
+    not read (the exact method's of a smoothed contact: eta, k_c); figures leave them out of
+    their titles (results still carry every parameter)."""
 
     field: Callable
     jacobian: Callable
@@ -288,6 +290,7 @@ class Method:
     curved: Callable | None = None
     dop853: bool = True
     evidence: str | None = None
+    unused: tuple = ()
 
 
 def _no_linear(mode, p, out):

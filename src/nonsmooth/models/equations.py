@@ -302,7 +302,8 @@ def _method(name, mname, entry, pnames) -> Method:
                   flow_is_homeomorphism=entry["flow_is_homeomorphism"],
                   modes=tuple(entry["modes"]), rtol=entry["rtol"], atol=entry["atol"],
                   continuous_memory=tuple(entry.get("continuous_memory", ())),
-                  description=entry["description"], **extra)
+                  description=entry["description"], unused=tuple(entry.get("unused", ())),
+                  **extra)
 
 
 def _derive(sp, ctx, name, mname, spec, states, pnames, mode_names, closed_form, bad) -> dict:
@@ -312,6 +313,9 @@ def _derive(sp, ctx, name, mname, spec, states, pnames, mode_names, closed_form,
     own = tuple(spec.get("modes") or {})
     if not own:
         raise bad(f"method {mname}: at least one mode is needed")
+    ctx.used = {s.name for v in ctx.memory_start for s in v.free_symbols}
+    if ctx.omega is not None:  # (the forcing frequency: the kernel's, whatever the method)
+        ctx.used.update(s.name for s in ctx.omega.free_symbols)
     fields = {}
     for mode, exprs in spec["modes"].items():
         exprs = list(exprs) if not isinstance(exprs, str) else [exprs]
@@ -384,7 +388,8 @@ def _derive(sp, ctx, name, mname, spec, states, pnames, mode_names, closed_form,
             "atol": None if atol is None else float(atol),
             "description": spec.get("description")
             or f"written as equations ({len(own)} mode{'' if len(own) == 1 else 's'})",
-            "admissible": None if text is None else str(text)}
+            "admissible": None if text is None else str(text),
+            "unused": [k for k in pnames if k not in ctx.used]}
 
 
 def _depends(sp, e, x) -> bool:
@@ -530,6 +535,7 @@ class _Context:
         self.memory_start = []  # their values at a fresh start
         self.local = {**sym, "t": t, "pi": sp.pi, **{f: getattr(sp, f) for f in FUNCTIONS},
                       **_smooth_steps(sp)}
+        self.used = set()  # the names the expressions parsed so far use (``_derive`` resets it)
 
     def bad(self, msg):
         return ParameterError(f"model {self.name}: {msg}")
@@ -562,6 +568,7 @@ class _Context:
             raise self.bad(f"{where}: unknown name {unknown[0]!r} (states and parameters"
                            f"{' and memory' if self.memory else ''}: "
                            f"{', '.join(k for k in self.sym)}; and t)")
+        self.used.update(s.name for s in expr.free_symbols)
         for pw in expr.atoms(sp.Piecewise):
             if not any(c is sp.true for _, c in pw.args):
                 raise self.bad(f"{where}: a Piecewise needs a last branch (value, True)")

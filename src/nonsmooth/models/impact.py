@@ -221,7 +221,7 @@ MODEL = Model(
                                      "with located switches"),
         "exact": Method(exact_field, exact_jacobian, exact_guards, exact_transition,
                         exact_initial, exact_linear, closed_form=True, modes=(FREE, STUCK),
-                        flow_is_homeomorphism=False,
+                        flow_is_homeomorphism=False, unused=("k_c",),
                         description="closed form between located impacts; chatter ends in "
                                     "sticking"),
     },

@@ -355,7 +355,7 @@ MODEL = Model(
         "exact": Method(exact_field, exact_jacobian, exact_guards, exact_transition,
                         exact_initial, exact_linear, closed_form=True,
                         modes=(SLIP_F, SLIP_B, STICK), flow_is_homeomorphism=False,
-                        rtol=1e-12, atol=1e-14,
+                        rtol=1e-12, atol=1e-14, unused=("eta",),
                         description="event-driven stick/slip: closed form in stick and "
                                     "Coulomb slip, DOP853 (rtol 1e-12) in Stribeck slip"),
     },

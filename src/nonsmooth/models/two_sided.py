@@ -469,7 +469,7 @@ MODEL = Model(
                         "velocity) by RKF45 at rtol 1e-12"),
         "exact": Method(exact_field, exact_jacobian, exact_guards, exact_transition,
                         exact_initial, exact_linear, closed_form=True, modes=(0, 3, 6),
-                        flow_is_homeomorphism=True,
+                        flow_is_homeomorphism=True, unused=("eta",),
                         description="closed form between located switching events"),
     },
     n_memory=N_MEMORY,

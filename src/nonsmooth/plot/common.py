@@ -222,10 +222,14 @@ def draw_phase_lines(ax, ds, *, label: bool = True, eta=None, vlim=None, **point
 
 
 def title_keys(ds, exclude=()) -> tuple:
-    """The parameter names of the dataset's model (in its order), less ``exclude``."""
+    """The parameter names of the dataset's model (in its order), less ``exclude`` and less
+    those its method does not read (``Method.unused``: the exact method's eta, k_c)."""
     m = model_of(ds)
     names = m.param_names if m is not None else tuple(
         k[6:] for k in getattr(ds, "attrs", {}) if k.startswith("param_"))
+    method = getattr(ds, "attrs", {}).get("method")
+    if m is not None and method in m.methods:
+        exclude = (*exclude, *m.methods[method].unused)
     return tuple(k for k in names if k not in exclude)
 
 
