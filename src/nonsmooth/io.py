@@ -176,17 +176,26 @@ def load_dataset(path):
         raise OutputError(f"input: cannot read {str(p)!r} as netCDF: {exc}") from None
 
 
+#: names a result file may take: netCDF's suffixes, or none (the CLI's ``-o``)
+NETCDF_SUFFIXES = ("", ".nc", ".nc4", ".netcdf", ".cdf", ".h5", ".hdf5")
+
+
+def figure_formats() -> dict:
+    """matplotlib's figure formats (suffix without the dot -> description)."""
+    from matplotlib.backend_bases import FigureCanvasBase
+    return FigureCanvasBase.get_supported_filetypes()
+
+
 def figure_path(path, what: str = "plot") -> Path:
     """The file a figure saved to ``path`` is written to: the format is the suffix (one of
     matplotlib's formats, else a one-line OutputError naming ``what``); no suffix means PNG,
     with ``.png`` appended (as matplotlib does). Checks that it can be written."""
-    from matplotlib.backend_bases import FigureCanvasBase
     p = Path(path)
     fmt = p.suffix[1:].lower()
     if not fmt:
         p = p.with_name(p.name + ".png")
-    elif fmt not in FigureCanvasBase.get_supported_filetypes():
-        known = ", ".join(sorted(FigureCanvasBase.get_supported_filetypes()))
+    elif fmt not in figure_formats():
+        known = ", ".join(sorted(figure_formats()))
         raise OutputError(f"{what}: unknown figure format {fmt!r} in {str(path)!r} (known: {known})")
     return check_writable(p, what)
 

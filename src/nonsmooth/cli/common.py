@@ -165,27 +165,18 @@ def resolve_method(params, method: str | None) -> str:
 def check_outputs(out: Path | None, plot: Path | None, **figures: Path | None) -> None:
     """Fail before computing if an output cannot be written or a figure format is unknown
     (``figures``: further figure options, e.g. ``orbits_plot=path``, named after the option)."""
-    from ..io import check_writable, figure_path
+    from ..io import NETCDF_SUFFIXES, check_writable, figure_formats, figure_path
 
     if out is not None:
         suffix = Path(out).suffix.lower()
         if suffix not in NETCDF_SUFFIXES:
-            hint = " (a figure: --plot)" if suffix[1:] in _figure_formats() else ""
+            hint = " (a figure: --plot)" if suffix[1:] in figure_formats() else ""
             raise OutputError(f"output: {str(out)!r}: a result is a netCDF file, give a name "
                               f"ending in .nc{hint}")
         planned[Path(out)] = check_writable(out, "output")
     for what, path in {"plot": plot, **figures}.items():
         if path is not None:
             planned[Path(path)] = figure_path(path, what.replace("_", "-"))
-
-
-#: names ``-o`` takes: netCDF's suffixes, or none
-NETCDF_SUFFIXES = ("", ".nc", ".nc4", ".netcdf", ".cdf", ".h5", ".hdf5")
-
-
-def _figure_formats():
-    from matplotlib.backend_bases import FigureCanvasBase
-    return FigureCanvasBase.get_supported_filetypes()
 
 
 def require_output(out: Path | None, plot: Path | None) -> None:
