@@ -792,8 +792,8 @@ def _g_eval(kind, s, cp, curved, mode, k, tau, C, S, hs, om, n, u, f0, u1, f1, p
     """(g, dg/dt) of guard k at the fraction s of the step: kind 0, an affine guard on a
     series piece (``cp``: its polynomial in time, ``linmodes.guard_poly``); kind 1, a curved
     guard (``_curved_at``)."""
-    if kind == 0:  # (at s = 0 the polynomial's first two terms, which ``pval`` returns there)
-        return (cp[0], cp[1]) if s == 0.0 else pval(cp, s * hs)
+    if kind == 0:
+        return pval(cp, s * hs)
     return _curved_at(curved, mode, k, tau, C, S, hs, om, n, u, f0, u1, f1, pp, mem, gr, us, s,
                       pm, TW)
 
