@@ -60,6 +60,14 @@ def test_simulate_another_builtin_model(tmp_path):
              "--periods", "1", "-o", "c.nc", cwd=tmp_path)
     assert r.returncode == 0, r.stderr
     assert load_dataset(tmp_path / "c.nc").attrs["preset"] == "stick_slip/coulomb"
+    # the summary names the model's first component (the ball's height Z, not X) and gives
+    # the dataset's max_X / min_X
+    r = _cli("simulate", "--model", "bouncing_ball", "--preset", "period_one", "--method",
+             "exact", "--periods", "2", "-o", "b.nc", cwd=tmp_path)
+    assert r.returncode == 0, r.stderr
+    ds = load_dataset(tmp_path / "b.nc")
+    assert f"max Z = {float(ds.max_X):.6g}, min Z = {float(ds.min_X):.6g}" in r.stdout
+    assert "max X" not in r.stdout
 
 
 @pytest.mark.parametrize("args, needle", [

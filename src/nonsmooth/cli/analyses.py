@@ -9,7 +9,7 @@ import typer
 
 from ..errors import ParameterError
 from .app import app
-from .common import (ShowOpt, U0Opt, DEFAULT_MODEL, SectionPhaseOpt, AtolOpt, DaskOpt, MethodOpt, ModelOpt, OutOpt, PlotOpt, PresetOpt, RtolOpt, SetOpt,
+from .common import (extent_text, ShowOpt, U0Opt, DEFAULT_MODEL, SectionPhaseOpt, AtolOpt, DaskOpt, MethodOpt, ModelOpt, OutOpt, PlotOpt, PresetOpt, RtolOpt, SetOpt,
                      WorkersOpt, check_outputs, chunk_store, echo_written, load_params,
                      preset_label, require_output, resolve_method, save_outputs)
 
@@ -129,7 +129,7 @@ def poincare_cmd(
     from ..plot.poincare import plot_poincare
     save_outputs(ds, preset, out, plot, lambda d: plot_poincare(d, show=pair))
     typer.echo(f"{preset}: {period_text(int(ds.period))}{motion_text(ds)}, contact "
-               f"{int(ds.contact)}, max X = {float(ds.max_X):.6g}, min X = {float(ds.min_X):.6g}")
+               f"{int(ds.contact)}, {extent_text(ds, params.model)}")
     echo_written(out, plot)
 
 

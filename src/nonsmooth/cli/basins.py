@@ -87,7 +87,7 @@ def basins_cmd(
                f"{ds.attrs['mean_periods_used']:.2f} periods per point on average")
     for k in range(n):
         kind = "chaotic" if int(ds.kind[k]) else f"period {int(ds.period[k])}"
-        typer.echo(f"  A{k}: {kind}, contact {int(ds.contact[k])}, max X {float(ds.max_X[k]):.6g}, "
+        typer.echo(f"  A{k}: {kind}, contact {int(ds.contact[k])}, max {params.model.state_names[0]} {float(ds.max_X[k]):.6g}, "
                    f"fraction {float(ds.fraction[k]):.4f}")
     if ent is not None:
         sbb = float(ent.boundary_basin_entropy)

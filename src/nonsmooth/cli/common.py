@@ -212,6 +212,13 @@ def save_outputs(ds, preset: str, out: Path | None, plot: Path | None, figure=No
         save_figure(figure(ds), plot)
 
 
+def extent_text(ds, model) -> str:
+    """'max X = ..., min X = ...' of a result's ``max_X`` / ``min_X``, named by the model's
+    first state component (the bouncing ball's Z)."""
+    x = model.state_names[0]
+    return f"max {x} = {float(ds.max_X):.6g}, min {x} = {float(ds.min_X):.6g}"
+
+
 def echo_written(*paths) -> None:
     """Print ``wrote <file>`` for each output path asked for (None skipped), under the name
     of the file actually written (a figure without suffix got ``.png``)."""

@@ -7,7 +7,7 @@ from typing import Annotated, Optional
 import typer
 
 from .app import app
-from .common import (ShowOpt, U0Opt, DEFAULT_MODEL, SectionPhaseOpt, AtolOpt, MethodOpt, ModelOpt, OutOpt, PlotOpt, PresetOpt, RtolOpt, SetOpt,
+from .common import (extent_text, ShowOpt, U0Opt, DEFAULT_MODEL, SectionPhaseOpt, AtolOpt, MethodOpt, ModelOpt, OutOpt, PlotOpt, PresetOpt, RtolOpt, SetOpt,
                      check_outputs, echo_written, load_params, preset_label,
                      require_output, resolve_method, save_outputs)
 
@@ -51,8 +51,8 @@ def simulate_cmd(
                       rtol=rtol, atol=atol, section_phase=section_phase, progress=prog, **spp)
     from ..plot.time_response import plot_time_response
     save_outputs(ds, preset, out, plot, lambda d: plot_time_response(d, show=pair))
-    typer.echo(f"{preset}: {periods} periods after {transient}, max X = {float(ds.max_X):.6g}, "
-               f"min X = {float(ds.min_X):.6g}, {params.model.mode_word} visited: "
+    typer.echo(f"{preset}: {periods} periods after {transient}, {extent_text(ds, params.model)}, "
+               f"{params.model.mode_word} visited: "
                f"{', '.join(mask_names(ds.regions_visited))}")
     echo_written(out, plot)
 

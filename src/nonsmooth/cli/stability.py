@@ -10,7 +10,7 @@ import typer
 
 from .analyses import TransientOpt, V0Opt, X0Opt, _progress
 from .app import app
-from .common import (U0Opt, DEFAULT_MODEL, SectionPhaseOpt, AtolOpt, MethodOpt, ModelOpt, OutOpt, PlotOpt, PresetOpt, RtolOpt, SetOpt, ShowOpt,
+from .common import (extent_text, U0Opt, DEFAULT_MODEL, SectionPhaseOpt, AtolOpt, MethodOpt, ModelOpt, OutOpt, PlotOpt, PresetOpt, RtolOpt, SetOpt, ShowOpt,
                      check_outputs, echo_written, load_params, preset_label, resolve_method,
                      save_outputs)
 
@@ -168,6 +168,5 @@ def orbit_cmd(
     mu1 = float(ds.multiplier_abs[0]) if ds.sizes["multiplier"] else math.nan
     rel = "<" if a["verdict"] == "stable" else "=" if a["verdict"] == "neutral" else ">"
     typer.echo(f"verdict: {a['verdict']} (|mu1| = {mu1:.6g} {rel} 1)")
-    typer.echo(f"max X = {float(ds.max_X):.6g}, min X = {float(ds.min_X):.6g}, "
-               f"contact fraction {float(ds.contact_fraction):.4g}")
+    typer.echo(f"{extent_text(ds, params.model)}, contact fraction {float(ds.contact_fraction):.4g}")
     echo_written(out, plot)
