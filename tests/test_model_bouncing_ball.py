@@ -96,3 +96,20 @@ def test_a_start_on_the_table_moving_into_it_bounces_at_once():
     V = 0.15 - g * t + A * w * (1 - np.cos(w * t))
     assert np.max(np.abs(ds.X.values[1:20] - Z)) < 1e-12
     assert np.max(np.abs(ds.V.values[1:20] - V)) < 1e-12
+
+
+def test_results_describe_the_height_z_not_the_papers_x():
+    """The result files' long names use the ball's own component names (Z, dZ/dt, its modes),
+    not the paper's model's (displacement X, region of eq. 14); the units are its own."""
+    import re
+    p = M.preset("period_one")
+    for ds in (ns.simulate(p, periods=2, method="exact"),
+               ns.poincare(p, record=8, transient=2, method="exact")):
+        for name in list(ds.data_vars) + list(ds.coords):
+            long = str(ds[name].attrs.get("long_name", ""))
+            assert not re.search(r"\bX\b|dX/dt|eq\. 14", long), (name, long)
+        assert "Z" in ds.max_X.attrs["long_name"] and ds.max_X.attrs["units"] == "m"
+    assert ds.V.attrs["units"] == "m/s"
+    sim = ns.simulate(p, periods=1, method="exact")
+    assert sim.X.attrs["long_name"] == M.state_long_names[0]
+    assert sim.region.attrs["long_name"] == "mode at t"

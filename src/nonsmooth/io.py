@@ -313,14 +313,35 @@ def xv_units(model) -> tuple:
     return (tuple(model.state_units) + ("1", "1/s")[len(model.state_units):])[:2]
 
 
+def state_long_name(model, i: int) -> str:
+    """The long name of state component i: the model's ``state_long_names``, else
+    "displacement X" / "velocity dX/dt" / the component's name."""
+    if len(model.state_long_names) > i:
+        return model.state_long_names[i]
+    return ("displacement X", "velocity dX/dt")[i] if i < 2 else model.state_names[i]
+
+
+def region_long_name(model) -> str:
+    """What a mode code is: the region of eq. 14 for the paper's model, a mode otherwise."""
+    return "region of eq. 14" if model.name == "support" else "mode"
+
+
 def apply_state_units(ds, model):
     """The units of every variable and coordinate of ``ds`` holding X or V (``X``, ``max_X``,
     ``X_section``, ``orbit_V``, ``x0``, ...) from the model's ``state_units`` (the analyses
-    write "1" and "1/s", the paper's dimensionless units); returns ``ds``."""
+    write "1" and "1/s", the paper's dimensionless units), and, for a model whose first
+    component is not called X (the bouncing ball's Z), that name in their long names
+    ("largest Z over ...", "dZ/dt"); returns ``ds``."""
     ux, uv = xv_units(model)
+    x = model.state_names[0]
     for name in list(ds.data_vars) + list(ds.coords):
         if _X_NAME.search(str(name)):
             ds[name].attrs["units"] = ux
         elif _V_NAME.search(str(name)):
             ds[name].attrs["units"] = uv
+        else:
+            continue
+        long = ds[name].attrs.get("long_name")
+        if x != "X" and isinstance(long, str):
+            ds[name].attrs["long_name"] = re.sub(r"\bX\b", x, long.replace("dX/dt", f"d{x}/dt"))
     return ds

@@ -11,7 +11,7 @@ import xarray as xr
 from . import status as st
 from .errors import IntegrationError, ParameterError
 from .integrate.contract import ST_EXTRA, ST_MODE
-from .io import apply_state_units, provenance_attrs
+from .io import apply_state_units, provenance_attrs, region_long_name, state_long_name
 from .kernels import Solver, new_state
 from .models.base import ParamsBase
 
@@ -282,10 +282,9 @@ def simulate(params: ParamsBase, *, periods: int, transient: int = 0,
     masks = flag_attrs(modes, dtype=np.uint8, masks=True)
     ds = xr.Dataset(
         {
-            "X": ("t", X, {"long_name": "displacement X = x/g" if params.model.name == "support"
-                           else "displacement X", "units": "1"}),
-            "V": ("t", V, {"long_name": "velocity dX/dt", "units": "1/s"}),
-            "region": ("t", R, dict(regions, long_name="region of eq. 14 at t")),
+            "X": ("t", X, {"long_name": state_long_name(params.model, 0), "units": "1"}),
+            "V": ("t", V, {"long_name": state_long_name(params.model, 1), "units": "1/s"}),
+            "region": ("t", R, dict(regions, long_name=region_long_name(params.model) + " at t")),
             "visited": ("t", M, dict(masks, long_name="regions visited since the previous "
                                                       "sample")),
             "X_max": ("t", Xmax, {"long_name": "largest X since the previous sample (interior "

@@ -582,7 +582,7 @@ def _dataset(params, solver, xs, vs, label, used, status, found, key, kind, cont
                        {"long_name": "period in forcing periods (0 = chaotic)", "units": "1"}),
             "contact": ("attractor", contact[key].astype(np.int8), flag_attrs(
                 ("no_contact", "contact"), dtype=np.int8,
-                long_name="orbit reaches the support (max X >= 1)")),
+                long_name=f"1: {params.model.contact_name}")),
             "max_X": ("attractor", max_x[key],
                       {"long_name": "largest X on the orbit", "units": "1"}),
             "attractor_X": (("attractor", "n"), AX,
