@@ -142,3 +142,5 @@ def test_cli_runs_one_figure(capsys, tmp_path):
     out = capsys.readouterr().out
     assert "report.md" in out
     assert (tmp_path / "report.html").is_file() and (tmp_path / "fig12c.png").is_file()
+    for name in ("report.md", "report.html", "summary.json"):  # every file it writes, named
+        assert f"wrote {tmp_path / name}" in out and (tmp_path / name).is_file()

@@ -611,7 +611,7 @@ def branches_dataset(params, param, values, solver, directions, out, **attrs) ->
             "min_X": (dims, mn, {"long_name": "smallest X over the recorded periods",
                                  "units": "1"}),
             "contact": (dims, contact, flag_attrs(("no_contact", "contact"), dtype=np.int8,
-                                                  long_name="contact with the support")),
+                                                  long_name=params.model.contact_name)),
             "status": (dims, out["status"], status_flags(long_name="kernel status")),
             "transient_used": (dims, out["used"], {
                 "long_name": "forcing periods integrated before the recorded window",

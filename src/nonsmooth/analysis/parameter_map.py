@@ -225,7 +225,7 @@ def _dataset(params, solver, xname, xs, yname, ys, out, attrs) -> xr.Dataset:
                                           "units": "1"}),
             "contact": (dims, out["contact"], flag_attrs(
                 ("no_contact", "contact"), dtype=np.int8,
-                long_name="contact with the support during the recorded periods")),
+                long_name=f"{params.model.contact_name} during the recorded periods")),
             "status": (dims, out["status"], status_flags(long_name="kernel status")),
             "transient_used": (dims, out["transient_used"], {
                 "long_name": "forcing periods integrated before the recorded window",

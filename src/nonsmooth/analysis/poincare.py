@@ -351,7 +351,7 @@ def poincare(params: ParamsBase, *, record: int | None = None, transient: int, x
             "min_X": ((), mn, {"long_name": "smallest X over the recorded periods (interior "
                                             "extrema included)", "units": "1"}),
             "contact": ((), np.int8(contact), flag_attrs(
-                ("no_contact", "contact"), dtype=np.int8, long_name="contact with the support "
+                ("no_contact", "contact"), dtype=np.int8, long_name=f"{params.model.contact_name} "
                 "during the recorded periods")),
             "status": ((), np.int64(st.OK), status_flags(long_name="kernel status")),
             "transient_used": ((), np.int64(used), {

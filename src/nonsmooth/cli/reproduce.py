@@ -40,6 +40,7 @@ def reproduce_cmd(
     n_all = sum(len(r.checks) for r in records)
     typer.echo(f"{len(records)} figures, {n_all} checks ({n_diff} differ from the paper), "
                f"{len(failed)} failed{': ' + ', '.join(failed) if failed else ''}")
-    typer.echo(f"wrote {out / 'report.md'}\nwrote {out / 'report.html'}")
+    typer.echo(f"wrote {out / 'report.md'}\nwrote {out / 'report.html'}\n"
+               f"wrote {out / 'summary.json'}")
     if failed:
         raise typer.Exit(1)
