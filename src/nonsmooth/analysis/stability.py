@@ -26,7 +26,7 @@ import xarray as xr
 from .. import status as st
 from ..errors import IntegrationError, ParameterError
 from ..integrate.contract import OPT_NO_EXTREMA, ST_H, ST_MODE
-from ..io import apply_state_units, check_memory, provenance_attrs
+from ..io import apply_state_units, check_memory, provenance_attrs, state_long_name
 from ..kernels import mode_holds, output_buffers, run, tangent_function
 from ..models.base import KERNEL_GENERIC
 from ..simulate import (check_float, check_int, component_variables, start_attrs,
@@ -405,10 +405,8 @@ def periodic_orbit(params, *, k: int = 1, x0: float = 0.0, v0: float = 0.0,
                        "units": "1"}),
             "contact_fraction": ((), float(in_contact.mean()), {
                 "long_name": "fraction of the orbit's samples in contact modes", "units": "1"}),
-            "X": ("t", X, {"long_name": params.model.state_long_names[0]
-                           if params.model.state_long_names else "X",
-                           "units": "1"}),
-            "V": ("t", V, {"long_name": "velocity dX/dt", "units": "1/s"}),
+            "X": ("t", X, {"long_name": state_long_name(params.model, 0), "units": "1"}),
+            "V": ("t", V, {"long_name": state_long_name(params.model, 1), "units": "1/s"}),
             **component_variables(params.model, "point", U[::spp][:k], suffix="_section",
                                   what=" at the section t = jT"),
             **component_variables(params.model, "t", U),
