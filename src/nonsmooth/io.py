@@ -315,10 +315,11 @@ def xv_units(model) -> tuple:
 
 def state_long_name(model, i: int) -> str:
     """The long name of state component i: the model's ``state_long_names``, else
-    "displacement X" / "velocity dX/dt" / the component's name."""
+    "displacement X" / "velocity dX/dt" / the component's variable name (``component_names``)."""
     if len(model.state_long_names) > i:
         return model.state_long_names[i]
-    return ("displacement X", "velocity dX/dt")[i] if i < 2 else model.state_names[i]
+    return ("displacement X", "velocity dX/dt")[i] if i < 2 else \
+        component_names(model.state_names)[i]
 
 
 def region_long_name(model) -> str:

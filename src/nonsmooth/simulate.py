@@ -172,9 +172,8 @@ def component_variables(model, dims, U, prefix: str = "", suffix: str = "",
     names = component_names(model.state_names)
     for i in range(2, model.n):
         units = model.state_units[i] if len(model.state_units) > i else "1"
-        long = model.state_long_names[i] if len(model.state_long_names) > i else names[i]
         out[f"{prefix}{names[i]}{suffix}"] = (dims, U[..., i], {
-            "long_name": f"{long}{what}", "units": units})
+            "long_name": f"{state_long_name(model, i)}{what}", "units": units})
     return out
 
 
