@@ -845,3 +845,36 @@ def test_rk8_tangent_is_the_derivative_of_the_rk8_step(n):
     continuous coordinate, equals central differences of the same step in u and in the
     slot."""
     _check_tangent_against_differences(_rk8_step_and_tangent, n)
+
+
+def test_cached_guard_bounds_equal_the_computed_ones():
+    """``hybrid._cf_bounds_cached`` (a closed-form mode re-entered with a guard set it had:
+    the support's free flight below and above X = 1) gives the coefficients that
+    ``_cf_bounds`` computes, for every set of a sequence that revisits, changes and evicts
+    sets, and only the sets it was given."""
+    from nonsmooth.integrate.contract import MAX_GUARDS
+    from nonsmooth.integrate.hybrid import (CF_SLOTS, MAX_MODES, _cf_bounds, _cf_bounds_cached)
+    from nonsmooth.integrate.pwlinear import N_BD, N_MC, mode_coeffs
+
+    n, om = 2, 0.9
+    MC = np.zeros((MAX_MODES, N_MC))
+    assert mode_coeffs(1.0, 0.1, 0.0, 0.5, om, 0.7, MC[0])
+    assert mode_coeffs(5.0, 0.3, 4.0, 0.5, om, 0.7, MC[1])
+    rows = {"below": [[-1.0, 0.0, 1.0, 0.0, 0.0]], "above": [[-1.0, -0.07, 1.0, 0.0, 0.0]],
+            "forced": [[1.0, 0.2, -1.0, 0.3, -0.4]], "two": [[1.0, 0.0, -1.0, 0, 0],
+                                                         [0.0, 1.0, 0.5, 0, 0]]}
+    GBC = np.zeros((MAX_MODES, CF_SLOTS, MAX_GUARDS, N_BD))
+    GKC = np.zeros((MAX_MODES, CF_SLOTS, MAX_GUARDS, n + 3))
+    GNC = np.zeros((MAX_MODES, CF_SLOTS + 1))
+    seq = [(0, "below"), (1, "forced"), (0, "above"), (0, "below"), (0, "above"), (1, "two"),
+           (0, "forced"), (0, "below"), (0, "above"), (1, "forced"), (1, "two"), (0, "below")]
+    for mode, key in seq:
+        G = np.zeros((MAX_GUARDS, n + 3))
+        ng = len(rows[key])
+        G[:ng] = rows[key]
+        want = np.full((MAX_GUARDS, N_BD), -1.0)
+        got = np.full((MAX_GUARDS, N_BD), -1.0)
+        _cf_bounds(MC, mode, om, G, ng, n, want)
+        _cf_bounds_cached(MC, mode, om, G, ng, n, got, GBC, GKC, GNC)
+        assert np.array_equal(got, want), (mode, key)
+        assert np.all(got[ng:] == -1.0)  # rows beyond ng untouched

@@ -673,6 +673,43 @@ def _cf_bounds(MC, mode, om, G, ng, n, GB):
         GB[k, BD_R] += math.hypot(G[k, n + 1], G[k, n + 2])
 
 
+#: Guard sets per mode whose bound coefficients ``_cf_bounds_cached`` keeps (a mode re-entered
+#: with one of them again, e.g. the support's free flight below and above X = 1, takes its
+#: coefficients from there)
+CF_SLOTS = 2
+
+
+@nb.njit(cache=True)
+def _cf_bounds_cached(MC, mode, om, G, ng, n, GB, GBC, GKC, GNC):
+    """:func:`_cf_bounds`, taken from the ``CF_SLOTS`` last guard sets of ``mode`` when the ng
+    rows are equal to one of them (the coefficients depend on the mode's closed form, fixed in a
+    call, and the rows only): GBC[mode, slot] the coefficients, GKC[mode, slot] the rows,
+    GNC[mode, slot] = ng + 1 (0: empty), GNC[mode, CF_SLOTS] the slot written next."""
+    m3 = n + 3
+    for sl in range(CF_SLOTS):
+        if GNC[mode, sl] != ng + 1:
+            continue
+        same = True
+        for k in range(ng):
+            for i in range(m3):
+                if GKC[mode, sl, k, i] != G[k, i]:
+                    same = False
+        if same:
+            for k in range(ng):
+                for b in range(N_BD):
+                    GB[k, b] = GBC[mode, sl, k, b]
+            return
+    _cf_bounds(MC, mode, om, G, ng, n, GB)
+    sl = int(GNC[mode, CF_SLOTS])
+    GNC[mode, CF_SLOTS] = (sl + 1) % CF_SLOTS
+    GNC[mode, sl] = ng + 1
+    for k in range(ng):
+        for i in range(m3):
+            GKC[mode, sl, k, i] = G[k, i]
+        for b in range(N_BD):
+            GBC[mode, sl, k, b] = GB[k, b]
+
+
 @nb.njit(cache=True)
 def _scan_step(cf, g0, d0, g1, d1, u, f0, u1, f1, C, S, C1, S1, G, k, n, q0, q1, q2, q3, om, hs,
                MC, mode, y0, z0, F, stack, BD):
@@ -940,7 +977,7 @@ def _series_rows(G, ng, n, ncv, no_ext, need):
         need[n + 1] = 1.0  # (the forcing pair: one flag, need[n + 1])
 
 
-@nb.njit(cache=True)
+@nb.njit(cache=True, inline="always")
 def _n_curved(G, ng, n):
     """How many of the ng guard rows are curved."""
     c = 0
@@ -1628,7 +1665,9 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
              _NS * nt * nj if nt == 2 or nt == 4 else 0,
              2 * nme if tan else 0, len(cmi), mt, n + 1,
              MAX_MODES + (N_TAYLOR + 1) * (m3 + 1) + n * n + n
-             + MAX_MODES * (n * m3 + 1) + 2 * m3 + 2 * MAX_GUARDS)
+             + MAX_MODES * (n * m3 + 1) + 2 * m3
+             + MAX_MODES * (CF_SLOTS * MAX_GUARDS * (N_BD + m3) + CF_SLOTS + 1)
+             + 2 * MAX_GUARDS)
     total = 0
     for z in sizes:
         total += z
@@ -1699,6 +1738,13 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
     need = view(ws, o, (m3,))  # the rows of the Taylor terms a full series piece needs
     ALL = view(ws, o + m3, (m3,))  # every row (a piece cut short, retaken, the last)
     o += 2 * m3
+    # the bound coefficients of the last guard sets of each closed-form mode
+    GBC = view(ws, o, (MAX_MODES, CF_SLOTS, MAX_GUARDS, N_BD))
+    o += MAX_MODES * CF_SLOTS * MAX_GUARDS * N_BD
+    GKC = view(ws, o, (MAX_MODES, CF_SLOTS, MAX_GUARDS, m3))
+    o += MAX_MODES * CF_SLOTS * MAX_GUARDS * m3
+    GNC = view(ws, o, (MAX_MODES, CF_SLOTS + 1))
+    o += MAX_MODES * (CF_SLOTS + 1)
     # each affine guard's g and g' at the step's end, which are those at the next step's start
     # while ``gv`` (an accepted step without a switch in a mode whose guards are all affine and
     # not a series piece's: the state, its derivative and the phase are copied from the end)
@@ -1779,13 +1825,14 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
             sgn = _section_side(G, ng, H, n, u, f0, C0, S0, om)
         ksec = ng
         ng += 1
-    _series_rows(G, ng, n, ncv, no_ext, need)
     cls = _mode_class(linear, closed, mode, pp, lin, MC, mcs, om, MF, n, MXR, PW)
     if cls == _MC_RESONANT:
         _store(state, u, n, mem, nmem, mode, h)
         keep_alive(ws)
         return st.RESONANCE
     cf, pm = _paths(cls, ncv, u[1], MC, mode)
+    if pm:
+        _series_rows(G, ng, n, ncv, no_ext, need)
     if cf:
         _cf_bounds(MC, mode, om, G, ng, n, GB)
 
@@ -2224,9 +2271,10 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
                                                pp, mem, gr)  # crossing
                 elif has_sec:
                     sgn = _section_side(G, ksec, H, n, u, f0, C, S, om)
-                _series_rows(G, ng, n, ncv, no_ext, need)  # (the section's row written)
+                if pm:  # (the section's row written)
+                    _series_rows(G, ng, n, ncv, no_ext, need)
                 if cf:
-                    _cf_bounds(MC, mode, om, G, ng, n, GB)
+                    _cf_bounds_cached(MC, mode, om, G, ng, n, GB, GBC, GKC, GNC)
                 if tan and not label and not _saltation(
                         transition, old_mode, k_tr, tau, C, S, om, n, ue, me, fm, gk, gdot,
                         mode, u, mem, f0, pp, Y, cmi, uc, mc, ua, ma, n_tiny > 0, tw_last):
