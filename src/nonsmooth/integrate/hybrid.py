@@ -1517,7 +1517,7 @@ def _cf_tangent(MC, mode, om, h, Y, PT):
         Y[1, c] = p10 * y0 + p11 * y1
 
 
-@nb.njit(cache=True)
+@nb.njit(cache=True, inline="always")
 def _saltation(transition, mode, k, tau, C, S, om, n, ue, me, fm, gk, gdot, new_mode, up, mp,
                fp, pp, Y, cmi, uc, mc, ua, ma, chained, tw_last):
     """Y <- the tangent just after the transition (mode, guard k) -> new_mode at (tau, ue, me).
@@ -1552,8 +1552,9 @@ def _saltation(transition, mode, k, tau, C, S, om, n, ue, me, fm, gk, gdot, new_
         for i in range(n):
             tw += gk[i] * Y[i, c]
         gn = 0.0
-        for i in range(n):
-            gn += abs(gk[i] * fm[i])
+        if chained:
+            for i in range(n):
+                gn += abs(gk[i] * fm[i])
         if chained and not gdot < -1e-6 * gn:
             tw = tw_last[c]
         else:
