@@ -372,7 +372,7 @@ def _g_full(cf, s, G, k, n, q0, q1, q2, q3, C, S, om, hs, MC, mode, y0, z0, F):
     return g, d, dd
 
 
-@nb.njit(cache=True)
+@nb.njit(cache=True, inline="always")
 def _guard_bounds(cf, G, k, n, q2, q3, om, hs, MC, mode, y0, z0, BD):
     """(M2, M3, M4): bounds of |g''|, |g'''|, |g''''| of guard k over the whole step. On a
     closed-form piece: the energy-norm bounds of the homogeneous part plus om^n times the
@@ -679,7 +679,7 @@ def _cf_bounds(MC, mode, om, G, ng, n, GB):
 CF_SLOTS = 2
 
 
-@nb.njit(cache=True)
+@nb.njit(cache=True, inline="always")
 def _cf_bounds_cached(MC, mode, om, G, ng, n, GB, GBC, GKC, GNC):
     """:func:`_cf_bounds`, taken from the ``CF_SLOTS`` last guard sets of ``mode`` when the ng
     rows are equal to one of them (the coefficients depend on the mode's closed form, fixed in a
@@ -722,7 +722,7 @@ def _scan_step(cf, g0, d0, g1, d1, u, f0, u1, f1, C, S, C1, S1, G, k, n, q0, q1,
                            hs, MC, mode, y0, z0, F, M2, M3, M4, stack)
 
 
-@nb.njit(cache=True)
+@nb.njit(cache=True, inline="always")
 def _first_crossing(cf, lo, hi, g0, d0, u, f0, C, S, G, k, n, q0, q1, q2, q3, om, hs, MC,
                     mode, y0, z0, F, stack, BD):
     """The located crossing [lo, hi] of guard k must be its first: g >= 0 on [0, lo] is
@@ -730,7 +730,25 @@ def _first_crossing(cf, lo, hi, g0, d0, u, f0, C, S, G, k, n, q0, q1, q2, q3, om
     A transversal crossing (g(lo) >= 0, g'(lo) < 0) needs no scan of its tail: g' <=
     g'(lo) + M2 (lo - s) hs < 0 there, so g decreases to g(lo) >= 0 on
     [lo - |g'(lo)| / (M2 hs), lo] (whose halving, down to pieces short enough for
-    ``classify``'s test from the end, took most of the scan). Returns the final (lo, hi)."""
+    ``classify``'s test from the end, took most of the scan). Returns the final (lo, hi).
+
+    Inlined into the kernel: the usual case, a crossing whose whole tail [0, lo] that test
+    covers, is decided here without a call; the others go on in :func:`_first_crossing_scan`,
+    which starts with the same test."""
+    if not lo > 0.0:
+        return lo, hi
+    M2 = _guard_bounds(cf, G, k, n, q2, q3, om, hs, MC, mode, y0, z0, BD)[0]
+    dl = _g_full(cf, lo, G, k, n, q0, q1, q2, q3, C, S, om, hs, MC, mode, y0, z0, F)[1]
+    if dl < 0.0 and M2 > 0.0 and not lo - 0.9 * (-dl / M2) / hs > 0.0:
+        return lo, hi  # g >= 0 on [0, lo] (decreasing to g(lo))
+    return _first_crossing_scan(cf, lo, hi, g0, d0, u, f0, C, S, G, k, n, q0, q1, q2, q3, om,
+                                hs, MC, mode, y0, z0, F, stack, BD)
+
+
+@nb.njit(cache=True)
+def _first_crossing_scan(cf, lo, hi, g0, d0, u, f0, C, S, G, k, n, q0, q1, q2, q3, om, hs, MC,
+                         mode, y0, z0, F, stack, BD):
+    """:func:`_first_crossing`'s test and scan, repeated while an earlier crossing is found."""
     M2, M3, M4 = _guard_bounds(cf, G, k, n, q2, q3, om, hs, MC, mode, y0, z0, BD)
     dd0 = _g_dd(cf, G, k, n, u, f0, C, S, om, MC, mode, F, 2.0 * q2, hs)
     for _ in range(8):
