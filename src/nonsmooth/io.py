@@ -322,11 +322,6 @@ def state_long_name(model, i: int) -> str:
         component_names(model.state_names)[i]
 
 
-def region_long_name(model) -> str:
-    """What a mode code is: the region of eq. 14 for the paper's model, a mode otherwise."""
-    return "region of eq. 14" if model.name == "support" else "mode"
-
-
 def apply_state_units(ds, model):
     """The units of every variable and coordinate of ``ds`` holding X or V (``X``, ``max_X``,
     ``X_section``, ``orbit_V``, ``x0``, ...) from the model's ``state_units`` (the analyses

@@ -11,7 +11,7 @@ import xarray as xr
 from . import status as st
 from .errors import IntegrationError, ParameterError
 from .integrate.contract import ST_EXTRA, ST_MODE
-from .io import apply_state_units, provenance_attrs, region_long_name, state_long_name
+from .io import apply_state_units, provenance_attrs, state_long_name
 from .kernels import Solver, new_state
 from .models.base import ParamsBase
 
@@ -283,7 +283,7 @@ def simulate(params: ParamsBase, *, periods: int, transient: int = 0,
         {
             "X": ("t", X, {"long_name": state_long_name(params.model, 0), "units": "1"}),
             "V": ("t", V, {"long_name": state_long_name(params.model, 1), "units": "1/s"}),
-            "region": ("t", R, dict(regions, long_name=region_long_name(params.model) + " at t")),
+            "region": ("t", R, dict(regions, long_name=params.model.mode_long_name + " at t")),
             "visited": ("t", M, dict(masks, long_name="regions visited since the previous "
                                                       "sample")),
             "X_max": ("t", Xmax, {"long_name": "largest X since the previous sample (interior "

@@ -54,7 +54,7 @@ import xarray as xr
 from .. import status as st
 from ..errors import IntegrationError
 from ..integrate.contract import ST_MODE
-from ..io import apply_state_units, provenance_attrs, region_long_name
+from ..io import apply_state_units, provenance_attrs
 from ..kernels import Solver
 from ..models.base import ParamsBase
 from .periodicity import (NOT_SETTLED, TOL_FACTOR, detect_period, section_tolerance,
@@ -359,7 +359,7 @@ def poincare(params: ParamsBase, *, record: int | None = None, transient: int, x
                 "units": "1"}),
             "orbit_X": ("sample", oX, {"long_name": "phase-portrait displacement", "units": "1"}),
             "orbit_V": ("sample", oV, {"long_name": "phase-portrait velocity", "units": "1/s"}),
-            "orbit_region": ("sample", oR, dict(regions, long_name=region_long_name(params.model))),
+            "orbit_region": ("sample", oR, dict(regions, long_name=params.model.mode_long_name)),
             **component_variables(params.model, "n", U, what=" at the section"),
             **component_variables(params.model, "sample", oU, prefix="orbit_",
                                   what=" (phase portrait)"),

@@ -72,7 +72,8 @@ signatures of :mod:`nonsmooth.integrate.contract`). It declares
 * what analyses and plots need: ``contact(params, mask, max_X, min_X)`` (does an orbit with
   this visited-mode mask and these extremes of X count as "in contact", named
   ``contact_name``; default: a mode of the bit mask ``contact_modes`` visited; ``contact_label``
-  a short name of those modes in tables, e.g. ``Gamma+``),
+  a short name of those modes in tables, e.g. ``Gamma+``), ``mode_long_name`` what a mode code
+  is in result files (default "mode"; the paper's model: "region of eq. 14"),
   ``contact_level(params)`` (the X at which contact starts, for the contact onset omega_a of
   ``resonance_curve``; None where it has no meaning), ``lines(params, method)`` (values of X to draw, with labels;
   ``params`` may be None when a result's parameters cannot be read), display data for figures
@@ -323,6 +324,7 @@ class Model:
     contact_modes: int = 0
     contact: Callable | None = None
     contact_name: str = "contact"
+    mode_long_name: str = "mode"
     contact_level: Callable | None = None
     lines: Callable | None = None
     mode_labels: tuple = ()

@@ -84,6 +84,7 @@ MODEL = Model(
     contact=_contact,
     contact_modes=0b1000,  # Gamma+: full support force (eta_study)
     contact_name="contact with the support (max X >= 1 and a band or Gamma+ visited)",
+    mode_long_name="region of eq. 14",
     lines=_lines,
     contact_level=lambda params: 1.0,
     mode_labels=(r"$\Gamma_-$", r"$\Sigma_\alpha$", r"$\Sigma_\beta$", r"$\Gamma_+$"),
