@@ -173,3 +173,29 @@ def test_an_output_below_a_file_names_the_file_as_not_a_folder(tmp_path):
         io.check_writable(tmp_path / "afile" / "x.nc")
     with pytest.raises(ns.errors.OutputError, match="does not exist$"):
         io.check_writable(tmp_path / "nope" / "x.nc")
+
+
+def test_an_output_the_filesystem_refuses_is_named_before_any_work(tmp_path, monkeypatch, capsys):
+    """As root, os.access says yes to /sys, whose filesystem then refuses the file: the error
+    named the sweep's chunk store (``store: cannot write '/sys/b.nc.chunks'``) instead of the
+    output. A file is now made and removed in the folder before any work."""
+    import errno
+    real_open = os.open
+
+    def refusing(path, *a, **k):
+        if str(path).endswith(".probe"):
+            raise OSError(errno.EPERM, "Operation not permitted")
+        return real_open(path, *a, **k)
+
+    monkeypatch.setattr(os, "open", refusing)
+    with pytest.raises(ns.errors.OutputError,
+                       match=r"^output: cannot write '.*b\.nc': Operation not permitted$"):
+        io.check_writable(tmp_path / "b.nc")
+    from cli_helpers import one_line, run_cli
+    code, _, err = run_cli(["bifurcation", "--from", "0.9", "--to", "0.91", "--steps", "2", "-o",
+                            str(tmp_path / "b.nc")], capsys)
+    assert code == 2
+    one_line(err, "output: cannot write")
+    monkeypatch.setattr(os, "open", real_open)
+    assert io.check_writable(tmp_path / "b.nc") == tmp_path / "b.nc"
+    assert list(tmp_path.iterdir()) == []  # the probe is removed

@@ -92,6 +92,9 @@ def test_eta_zero_is_accepted_for_the_exact_method(capsys, tmp_path):
     ds = ns.io.load_dataset(out)
     ref = ns.simulate(ns.preset("table3").replace(omega=0.92), periods=2, method="exact")
     assert np.array_equal(ds.X.values, ref.X.values)
+    # the file says that the eta it carries (the preset's) is not read by the exact method
+    assert ds.attrs["unused_parameters"] == "eta"
+    assert "unused_parameters" not in ns.simulate(ns.preset("table3"), periods=1).attrs
     # still refused for the smoothed model, and not a number is still an error
     code, _, err = run_cli(["simulate", "--preset", "table3", "--set", "eta=0", "--periods", "2",
                             "-o", str(tmp_path / "s.nc")], capsys)

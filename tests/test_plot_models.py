@@ -139,3 +139,25 @@ def test_a_user_models_figures_find_the_model_in_the_process_and_from_its_file(m
     monkeypatch.setattr(models, "_USED", {})
     ds.attrs["model_source"] = f"{tmp_path / 'gone.py'}:MODEL"
     assert model_of(ds) is None and model_lines(ds) == []
+
+
+def test_section_axes_name_the_model_s_own_components():
+    # the bouncing ball's first component is Z: the Poincaré map and the bifurcation diagram
+    # label it Z(kT), not X(kT) (support's labels stay X(kT), V(kT), as before)
+    ball = ns.model("bouncing_ball")
+    p = ball.preset("period_one")
+    ds = poincare(p, record=2, transient=2, method="exact", orbit_samples=20, orbit_periods=1)
+    ax = plot_poincare(ds).axes[1]
+    assert (ax.get_xlabel(), ax.get_ylabel()) == ("$Z(kT)$", "$V(kT)$")
+    bd = bifurcation_diagram(p, "A", np.array([1.2, 1.3]) / (4 * np.pi**2), method="exact",
+                             transient=2, record=2, settle=False, sweep="up")
+    assert plot_bifurcation(bd).axes[0].get_ylabel() == "$Z(kT)$"
+    assert plot_bifurcation(bd, var="V").axes[0].get_ylabel() == r"$\dot Z(kT)$"
+
+
+@pytest.mark.parametrize("name,method", CASES)
+def test_support_s_section_labels_are_unchanged(results, name, method):
+    ax = plot_poincare(results[name, method]["poincare"]).axes[1]
+    assert (ax.get_xlabel(), ax.get_ylabel()) == ("$X(kT)$", "$V(kT)$")
+    assert plot_bifurcation(results[name, method]["bifurcation"]).axes[0].get_ylabel() \
+        == "$X(kT)$"

@@ -97,6 +97,13 @@ def check_writable(path, what: str = "output") -> Path:
         raise OutputError(f"{what}: cannot write {str(p)!r}: {str(parent)!r} {why}")
     if not os.access(parent, os.W_OK) or (p.exists() and not os.access(p, os.W_OK)):
         raise OutputError(f"{what}: cannot write {str(p)!r}: permission denied")
+    if not p.exists():  # a file made and removed: os.access says yes to root where the
+        probe = parent / f".{p.name}.{uuid.uuid4().hex[:8]}.probe"  # filesystem says no (/sys)
+        try:
+            os.close(os.open(probe, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o600))
+            os.unlink(probe)
+        except OSError as exc:
+            raise OutputError(f"{what}: cannot write {str(p)!r}: {exc.strerror or exc}") from None
     return p
 
 

@@ -246,6 +246,8 @@ class Solver:
              "section_phase": self.section_phase}
         if self.model.source != "built-in":  # a user's file (``path.py:NAME``): figures load it
             a["model_source"] = self.model.source
+        if m.unused:  # (their param_* attrs are the values kept, not read: exact's eta)
+            a["unused_parameters"] = " ".join(m.unused)
         if self.code == KERNEL_SUPPORT_SMOOTH:
             a["integrator"] = smooth_integrator()
         elif self.code == KERNEL_SUPPORT_EXACT:

@@ -66,7 +66,8 @@ def plot_bifurcation(ds, var: str = "X", lyapunov=None):
         draw_lambda1(lax, ds, param, vals)
         lax.set_xlabel(ax.get_xlabel())
         ax.xaxis.label.set_visible(False)
-    ax.set_ylabel(r"$X(kT)$" if var == "X" else r"$\dot X(kT)$")
+    x = str(ds.attrs.get("state_names", "X")).split()[0]  # (the model's own: the ball's Z)
+    ax.set_ylabel(f"${x}(kT)$" if var == "X" else rf"$\dot {x}(kT)$")
     ax.set_xlim(vals[0], vals[-1])
     ttl = f"bifurcation diagram, {ds.sizes['n']} section points per value"
     if failed:

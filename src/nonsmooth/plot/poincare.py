@@ -40,8 +40,8 @@ def plot_poincare(ds, show=None):
     n = X.size
     ax1.scatter(X, V, s=25.0 if few else (1.0 if n > 500 else 6.0), color="k", linewidths=0)
     names = str(ds.attrs.get("state_names", "X V")).split()
-    ax1.set_xlabel(r"$X(kT)$" if ia == 0 else f"${names[ia]}(kT)$")
-    ax1.set_ylabel(r"$V(kT)$" if ib == 1 else f"${names[ib]}(kT)$")
+    ax1.set_xlabel(f"${names[ia]}(kT)$")  # (the model's own names: the ball's Z)
+    ax1.set_ylabel(f"${names[ib]}(kT)$")
     title = f"(b) Poincaré map, {n} points after {ds.attrs.get('transient', '?')} periods"
     spread = _zoom_out(ax1, X, V, oX, oV)
     if spread is not None:
