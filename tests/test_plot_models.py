@@ -156,7 +156,8 @@ def test_section_axes_name_the_model_s_own_components():
 
 
 @pytest.mark.parametrize("name,method", CASES)
-def test_support_s_section_labels_are_unchanged(results, name, method):
+def test_x_v_models_keep_their_section_labels(results, name, method):
+    # support and stick_slip (components X, V): the labels as before
     ax = plot_poincare(results[name, method]["poincare"]).axes[1]
     assert (ax.get_xlabel(), ax.get_ylabel()) == ("$X(kT)$", "$V(kT)$")
     assert plot_bifurcation(results[name, method]["bifurcation"]).axes[0].get_ylabel() \
