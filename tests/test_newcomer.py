@@ -106,3 +106,40 @@ def test_eta_zero_is_accepted_for_the_exact_method(capsys, tmp_path):
     one_line(err, "eta: expected a number")
     code, stdout, err = run_cli(["simulate", "--help"], capsys)
     assert "ignored" in " ".join(stdout.split())
+
+
+def test_bad_options_are_refused_before_the_kernels_load(tmp_path):
+    """A newcomer on a fresh machine waited 4-9 minutes (the kernels' first compile) for the
+    one line refusing `--periods -5`, an unwritable `-o`, a reversed range, ...: the commands
+    imported their analysis, and with it the kernels, before checking their own options. Now
+    those are checked first: none of these imports ``nonsmooth.kernels`` (one fresh process)."""
+    import subprocess
+    import sys
+    bad = tmp_path / "missing" / "x.nc"
+    cases = [
+        ["simulate", "--periods", "-5", "-o", "a.nc"],
+        ["simulate", "-o", "x.png"],
+        ["simulate"],
+        ["simulate", "--method", "rk4", "-o", "a.nc"],
+        ["simulate", "--plot", str(tmp_path / "missing" / "p.png")],
+        ["poincare", "--record", "0", "-o", "a.nc"],
+        ["poincare", "-o", str(bad)],
+        ["bifurcation", "--from", "1.0", "--to", "0.9", "-o", "a.nc"],
+        ["bifurcation", "--steps", "0", "-o", "a.nc"],
+        ["bifurcation", "--sweep", "sideways", "-o", "a.nc"],
+        ["resonance", "--from", "1.0", "--to", "0.9", "-o", "a.nc"],
+        ["basins", "-o", str(bad)],
+        ["attractors", "--from", "1.2", "--to", "1.1", "-o", "a.nc"],
+        ["map", "-o", str(bad)],
+    ]
+    code = ("import sys, json\nfrom nonsmooth.cli import main\nout = []\n"
+            f"for argv in {cases!r}:\n"
+            "    try:\n        main(argv)\n    except SystemExit as e:\n        out.append(e.code)\n"
+            "print(json.dumps([out, 'nonsmooth.kernels' in sys.modules]))\n")
+    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                       cwd=tmp_path, timeout=300)
+    import json
+    codes, loaded = json.loads(r.stdout.strip().splitlines()[-1])
+    assert codes == [2] * len(cases), (codes, r.stderr)
+    assert [ln for ln in r.stderr.splitlines() if ln.strip()][0].startswith("error: periods:")
+    assert not loaded, "a command imported the kernels before refusing a bad option"

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import math
 import warnings
 
 import numpy as np
@@ -13,67 +12,9 @@ from .errors import IntegrationError, ParameterError
 from .integrate.contract import ST_EXTRA, ST_MODE
 from .io import apply_state_units, provenance_attrs, state_long_name
 from .kernels import Solver, new_state
+from .checks import (check_float, check_forced, check_int, check_params,  # noqa: F401
+                     component_pair)  # (here first)
 from .models.base import ParamsBase
-
-
-def check_int(name: str, value, minimum: int) -> int:
-    """``value`` as an int >= minimum, else a one-line ParameterError naming ``name``."""
-    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, np.integer)):
-        if isinstance(value, (float, np.floating)) and float(value).is_integer():
-            value = int(value)
-        else:
-            raise ParameterError(f"{name}: expected a whole number, got {value!r}")
-    if value < minimum:
-        raise ParameterError(f"{name}: must be >= {minimum}, got {value}")
-    return int(value)
-
-
-def check_float(name: str, value) -> float:
-    try:
-        v = float(value)
-    except (TypeError, ValueError):
-        raise ParameterError(f"{name}: expected a number, got {value!r}") from None
-    if not math.isfinite(v):
-        raise ParameterError(f"{name}: must be finite, got {v}")
-    return v
-
-
-def check_params(params) -> ParamsBase:
-    """``params`` if it is a model's validated parameters (``model(...).params(...)``,
-    ``preset(...)``), else a one-line ParameterError."""
-    if not isinstance(params, ParamsBase):
-        raise ParameterError(f"params: expected model(...).params(...) or preset(...), "
-                             f"got {type(params).__name__}")
-    return params
-
-
-def check_forced(params, who: str) -> None:
-    """A one-line ParameterError where ``who`` (a stroboscopic analysis) gets a model that
-    declares no forcing: it has no period to sample."""
-    if check_params(params).model.autonomous:
-        raise ParameterError(f"{who}: model {params.model.name} declares no forcing "
-                             f"(omega=None): a stroboscopic map has no period to sample; use "
-                             f"its section surfaces (limit_cycle, limit_cycle_branch, "
-                             f"surface_basins, equilibria) or simulate")
-
-
-def component_pair(pair, names, field: str) -> tuple | None:
-    """``pair`` (None, "X,Y" or a pair of component names) as a pair of names among ``names``
-    (the model's ``state_names``); a one-line ParameterError naming ``field`` otherwise."""
-    if pair is None:
-        return None
-    try:
-        parts = [t.strip() for t in pair.split(",")] if isinstance(pair, str) else list(pair)
-    except TypeError:
-        parts = []
-    if len(parts) != 2:
-        raise ParameterError(f"{field}: expected two state components (e.g. "
-                             f"{','.join(names[:2])}), got {pair!r}")
-    for name in parts:
-        if name not in names:
-            raise ParameterError(f"{field}: unknown component {name!r} (the model has "
-                                 f"{', '.join(names)})")
-    return tuple(parts)
 
 
 def initial_u(model, x0=0.0, v0=0.0, u0=None) -> np.ndarray:

@@ -20,6 +20,7 @@ import numpy as np
 import xarray as xr
 
 from .. import status as st
+from ..checks import SWEEPS, check_sweep_memory  # noqa: F401 (here first)
 from ..errors import ParameterError
 from ..io import apply_state_units, provenance_attrs
 from ..integrate.contract import KERNEL_FN_TYPE, MODEL_FNS_TYPE
@@ -29,7 +30,6 @@ from ..sweep import parallel_chunks
 from .poincare import (MAX_PERIOD, PERIOD_LONG_NAME, SETTLE_WINDOW, classify_many, settle,
                        settle_tolerance)
 
-SWEEPS = ("up", "down", "both", "fresh")
 
 
 @nb.njit(cache=True)
@@ -145,19 +145,6 @@ def param_rows(params: ParamsBase, param: str, values) -> np.ndarray:
     rows = np.tile(params.pack(), (values.size, 1))
     rows[:, params.model.index[param]] = values
     return rows
-
-
-def check_sweep_memory(n_values: int, n_branches: int, record: int, field: str = "values") -> None:
-    """Refuse, before computing (and before the values are built: the CLI calls it with the
-    typed ``--steps``), a sweep whose section data would not fit in memory; the line names the
-    larger of ``field`` (the number of values) and ``record``, and the largest that fits."""
-    from ..io import check_memory
-    big = ("record", record) if record >= n_values else (field, n_values)  # the larger factor
-    check_memory(34.0 * n_values * n_branches * record + 8.0 * n_values, big[0],
-                 (f"{n_values:,} values x {n_branches} sweep(s) x {record:,} recorded periods; "
-                  f"sweep fewer values or record fewer periods per value") if record else
-                 f"{n_values:,} values; use fewer values",
-                 size=(big[1], 1))
 
 
 def follow(P, solver: Solver, states, init, transient: int, settle_tol: float, record: int,

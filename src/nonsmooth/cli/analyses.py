@@ -52,7 +52,7 @@ def value_range(lo: float, hi: float, steps: int, name: str = "range", branches:
     of ``branches`` sweeps recording ``record`` periods each must fit in memory, checked
     before the values are built)."""
     import numpy as np
-    from ..analysis.bifurcation import check_sweep_memory
+    from ..checks import check_sweep_memory
     for end, v in (("from", lo), ("to", hi)):
         if not math.isfinite(v):
             raise ParameterError(f"{end}: must be finite, got {v}")
@@ -110,8 +110,7 @@ def poincare_cmd(
     """Stroboscopic Poincaré map (t = kT) with period and contact classification; plot like
     Figs. 10 and 12 (phase portrait with its section points, and the map)."""
     params = load_params(preset, set_, model, "table3", method=method)
-    from ..analysis.poincare import poincare
-    from ..simulate import check_int
+    from ..checks import check_int
     if points is not None:  # deprecated name
         record = check_int("points", points, 1)
     method = resolve_method(params, method)
@@ -122,6 +121,7 @@ def poincare_cmd(
     pair = check_show(show, params.model.state_names)
     require_output(out, plot)
     check_outputs(out, plot)
+    from ..analysis.poincare import poincare  # (after the checks: the kernels load with it)
     with _progress("poincare") as prog:
         ds = poincare(params, record=record, transient=transient, x0=x0, v0=v0, u0=u0, method=method,
                       rtol=rtol, atol=atol, section_phase=section_phase, orbit_samples=orbit_samples,
@@ -172,11 +172,10 @@ def bifurcation_cmd(
 ):
     """Bifurcation diagram of the section X(kT) over a parameter (Figs. 9 and 11)."""
     params = load_params(preset, set_, model, "table3", method=method)
-    from ..analysis.bifurcation import SWEEPS, bifurcation_diagram
-    from ..simulate import check_int
+    from ..checks import SWEEPS, check_int
     method = resolve_method(params, method)
     preset = preset_label(params, preset, "table3")
-    from ..simulate import check_forced
+    from ..checks import check_forced
     check_forced(params, "bifurcation")
     param = params.model.param(param or params.model.forcing_param).name
     from_, to = default_range(params, param, from_, to, 0.8, 1.0)
@@ -190,6 +189,7 @@ def bifurcation_cmd(
     check_int("record", record, 1)
     require_output(out, plot)
     check_outputs(out, plot)
+    from ..analysis.bifurcation import bifurcation_diagram  # (after the checks)
     store, engine = chunk_store(out, dask)
     with _progress(f"bifurcation {param} ({sweep})") as prog:
         ds = bifurcation_diagram(params, param, values, sweep=sweep, transient=transient,
@@ -233,11 +233,10 @@ def resonance_cmd(
     """Resonance curve (max X, min X versus omega, swept up and down with continuation) and
     the frequencies omega_a (contact starts), omega_b, omega_c (jumps), like Fig. 6."""
     params = load_params(preset, set_, model, "fig6a", method=method)
-    from ..analysis.resonance import resonance_curve
-    from ..simulate import check_int
+    from ..checks import check_int
     method = resolve_method(params, method)
     preset = preset_label(params, preset, "fig6a")
-    from ..simulate import check_forced
+    from ..checks import check_forced
     check_forced(params, "resonance")
     w = params.model.forcing_param  # the model's forcing frequency (or period)
     from_, to = default_range(params, w, from_, to, 0.5, 1.6)
@@ -248,6 +247,7 @@ def resonance_cmd(
     check_int("record", record, 1)
     require_output(out, plot)
     check_outputs(out, plot)
+    from ..analysis.resonance import resonance_curve  # (after the checks)
     store, engine = chunk_store(out, dask)
     with _progress("resonance (up and down)") as prog:
         ds = resonance_curve(params, omegas, method=method, transient=transient, record=record,

@@ -45,9 +45,7 @@ def basins_cmd(
     image and a Fig. 8-style figure of the coexisting attractors."""
     import warnings
 
-    from ..analysis.basins import basins
     from ..io import save_figure
-    from ..sweep import Progress
 
     params = load_params(preset, set_, model, "fig7", method=method)
     method = resolve_method(params, method)
@@ -58,6 +56,8 @@ def basins_cmd(
     if entropy:
         from ..analysis.basin_entropy import check_box
         check_box(box, grid)
+    from ..analysis.basins import basins  # (after the checks: the kernels load with it)
+    from ..sweep import Progress
     store, engine = chunk_store(out, dask)
     with Progress("basins") as bar, warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always", UserWarning)
@@ -128,12 +128,10 @@ def attractors_cmd(
     deaths. With -o, finished values are kept in <out>.chunks until the result is written:
     the same command resumes an interrupted run."""
     params = load_params(preset, set_, model, "fig7", method=method)
-    from ..analysis.attractor_continuation import attractor_continuation
-    from ..sweep import Progress
     from .analyses import default_range, value_range
     method = resolve_method(params, method)
     preset = preset_label(params, preset, "fig7")
-    from ..simulate import check_forced
+    from ..checks import check_forced
     check_forced(params, "attractors")
     param = params.model.param(param or params.model.forcing_param).name
     from_, to = default_range(params, param, from_, to, 1.0, 1.25)
@@ -142,6 +140,8 @@ def attractors_cmd(
         params.replace(**{param: float(val)})
     require_output(out, plot)
     check_outputs(out, plot)
+    from ..analysis.attractor_continuation import attractor_continuation  # (after the checks)
+    from ..sweep import Progress
     store, engine = chunk_store(out, dask)
     with Progress(f"attractors over {param}") as bar:
         ds = attractor_continuation(params, param, values, x=x, v=v, grid=grid, method=method,

@@ -112,7 +112,7 @@ def continue_cmd(
     self-excited system on that section surface, their periods unknowns."""
     params = load_params(preset, set_, model, "fig6a", method=method or "exact")
     from ..analysis.continuation import continuation
-    from ..simulate import check_float, check_int
+    from ..checks import check_float, check_int
     if method is None and "exact" in params.model.methods:
         method = "exact"
     method = resolve_method(params, method)

@@ -60,7 +60,7 @@ def manifolds_cmd(
     params = load_params(preset, set_, model, "fig7", method=method or "exact")
     from ..analysis.manifolds import BRANCH_NAMES, manifolds
     from ..analysis.stability import periodic_orbit
-    from ..simulate import check_int
+    from ..checks import check_int
     if method is None and "exact" in params.model.methods:
         method = "exact"
     method = resolve_method(params, method)

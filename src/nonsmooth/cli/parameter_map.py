@@ -58,10 +58,9 @@ def map_cmd(
     """Two-parameter map of the settled motion: period, chaos (lambda1), amplitude, contact.
     With -o the finished chunks are kept in FILE.chunks and the same command resumes there."""
     params = load_params(preset, set_, model, "table3", method=method)
-    from ..analysis.parameter_map import parameter_map, regimes
     method = resolve_method(params, method)
     preset = preset_label(params, preset, "table3")
-    from ..simulate import check_forced
+    from ..checks import check_forced
     check_forced(params, "map")
     w = params.model.forcing_param
     x = tuple(x) if x is not None else (w, *params.model.forcing_range(0.8, 1.0), 100)
@@ -73,6 +72,7 @@ def map_cmd(
         y = ("F0", 0.15, 0.45, 100)
     require_output(out, plot if plot is not None else lambda_plot)
     check_outputs(out, plot, lambda_plot=lambda_plot)
+    from ..analysis.parameter_map import parameter_map, regimes  # (after the checks)
     store, engine = chunk_store(out, dask)
     with _progress(f"map {x[0]} x {y[0]}") as prog:
         ds = parameter_map(params, x=x, y=tuple(y), transient=transient, record=record,

@@ -36,14 +36,18 @@ def simulate_cmd(
     """Integrate one trajectory; save every state component and the region over time (netCDF)
     and a Fig. 3-style plot."""
     params = load_params(preset, set_, model, "table1", method=method)
-    from ..simulate import simulate
     method = resolve_method(params, method)
     preset = preset_label(params, preset, "table1")
     from ..plot.common import check_show
     pair = check_show(show, params.model.state_names)
     require_output(out, plot)
     check_outputs(out, plot)
-    from ..simulate import mask_names
+    from ..checks import check_int  # (checked again by simulate: here before the kernels load)
+    check_int("periods", periods, 1)
+    check_int("transient", transient, 0)
+    if samples_per_period is not None:
+        check_int("samples_per_period", samples_per_period, 1)
+    from ..simulate import mask_names, simulate
     from .analyses import _progress
     spp = {} if samples_per_period is None else {"samples_per_period": samples_per_period}
     with _progress("simulate") as prog:

@@ -77,7 +77,7 @@ def lyapunov_cmd(
     standard errors, their sum and a verdict (chaotic, quasi-periodic, not settled)."""
     params = load_params(preset, set_, model, "table3", method=method)
     from ..analysis.stability import lyapunov
-    from ..simulate import check_int
+    from ..checks import check_int
     method = resolve_method(params, method)
     preset = preset_label(params, preset, "table3")
     check_int("periods", periods, 1)
@@ -129,7 +129,7 @@ def orbit_cmd(
     with the multipliers (in the plane --show names). Exit status 1 when no orbit was found."""
     params = load_params(preset, set_, model, "fig7", method=method or "exact")
     from ..analysis.stability import periodic_orbit
-    from ..simulate import check_int
+    from ..checks import check_int
     if method is None and "exact" in params.model.methods:
         method = "exact"
     method = resolve_method(params, method)

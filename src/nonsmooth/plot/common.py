@@ -84,7 +84,7 @@ def state_labels(ds) -> tuple:
 def check_show(show, names, field: str = "show") -> tuple | None:
     """``show`` (None, "X,Y" or a pair of component names) as a pair of names among ``names``
     (``simulate.component_pair``)."""
-    from ..simulate import component_pair
+    from ..checks import component_pair
     return component_pair(show, names, field)
 
 

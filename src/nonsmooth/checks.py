@@ -1,0 +1,88 @@
+"""Checks of plain arguments (counts, numbers, parameters, forcing, a sweep's memory): one-line
+ParameterErrors naming the field. A light module (no kernels imported), so that the CLI checks a
+command's options before it imports the analyses, whose kernels compile on a fresh machine."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from .errors import ParameterError
+from .models.base import ParamsBase
+
+#: the sweep directions of ``bifurcation_diagram``
+SWEEPS = ("up", "down", "both", "fresh")
+
+
+def check_int(name: str, value, minimum: int) -> int:
+    """``value`` as an int >= minimum, else a one-line ParameterError naming ``name``."""
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, np.integer)):
+        if isinstance(value, (float, np.floating)) and float(value).is_integer():
+            value = int(value)
+        else:
+            raise ParameterError(f"{name}: expected a whole number, got {value!r}")
+    if value < minimum:
+        raise ParameterError(f"{name}: must be >= {minimum}, got {value}")
+    return int(value)
+
+
+def check_float(name: str, value) -> float:
+    try:
+        v = float(value)
+    except (TypeError, ValueError):
+        raise ParameterError(f"{name}: expected a number, got {value!r}") from None
+    if not math.isfinite(v):
+        raise ParameterError(f"{name}: must be finite, got {v}")
+    return v
+
+
+def check_params(params) -> ParamsBase:
+    """``params`` if it is a model's validated parameters (``model(...).params(...)``,
+    ``preset(...)``), else a one-line ParameterError."""
+    if not isinstance(params, ParamsBase):
+        raise ParameterError(f"params: expected model(...).params(...) or preset(...), "
+                             f"got {type(params).__name__}")
+    return params
+
+
+def check_forced(params, who: str) -> None:
+    """A one-line ParameterError where ``who`` (a stroboscopic analysis) gets a model that
+    declares no forcing: it has no period to sample."""
+    if check_params(params).model.autonomous:
+        raise ParameterError(f"{who}: model {params.model.name} declares no forcing "
+                             f"(omega=None): a stroboscopic map has no period to sample; use "
+                             f"its section surfaces (limit_cycle, limit_cycle_branch, "
+                             f"surface_basins, equilibria) or simulate")
+
+
+def check_sweep_memory(n_values: int, n_branches: int, record: int, field: str = "values") -> None:
+    """Refuse, before computing (and before the values are built: the CLI calls it with the
+    typed ``--steps``), a sweep whose section data would not fit in memory; the line names the
+    larger of ``field`` (the number of values) and ``record``, and the largest that fits."""
+    from .io import check_memory
+    big = ("record", record) if record >= n_values else (field, n_values)  # the larger factor
+    check_memory(34.0 * n_values * n_branches * record + 8.0 * n_values, big[0],
+                 (f"{n_values:,} values x {n_branches} sweep(s) x {record:,} recorded periods; "
+                  f"sweep fewer values or record fewer periods per value") if record else
+                 f"{n_values:,} values; use fewer values",
+                 size=(big[1], 1))
+
+
+def component_pair(pair, names, field: str) -> tuple | None:
+    """``pair`` (None, "X,Y" or a pair of component names) as a pair of names among ``names``
+    (the model's ``state_names``); a one-line ParameterError naming ``field`` otherwise."""
+    if pair is None:
+        return None
+    try:
+        parts = [t.strip() for t in pair.split(",")] if isinstance(pair, str) else list(pair)
+    except TypeError:
+        parts = []
+    if len(parts) != 2:
+        raise ParameterError(f"{field}: expected two state components (e.g. "
+                             f"{','.join(names[:2])}), got {pair!r}")
+    for name in parts:
+        if name not in names:
+            raise ParameterError(f"{field}: unknown component {name!r} (the model has "
+                                 f"{', '.join(names)})")
+    return tuple(parts)
