@@ -70,16 +70,9 @@ def dimensionless(*, m: float, k: float, c: float, k_s: float, c_s: float, f0: f
     """The non-dimensional values of eq. 3 from dimensional quantities: mass m, stiffnesses k,
     k_s, dampings c, c_s, forcing amplitude f0, gap g, forcing frequency omega and band width
     eta_hat (same length unit as g). One-line ParameterError naming the quantity otherwise."""
-    vals = {}
-    for name, v in dict(m=m, k=k, c=c, k_s=k_s, c_s=c_s, f0=f0, g=g, omega=omega,
-                        eta_hat=eta_hat).items():
-        try:
-            v = float(v)
-        except (TypeError, ValueError):
-            raise ParameterError(f"{name}: expected a number, got {v!r}") from None
-        if not math.isfinite(v):
-            raise ParameterError(f"{name}: must be finite, got {v!r}")
-        vals[name] = v
+    from ...checks import check_float
+    vals = {name: check_float(name, v) for name, v in dict(
+        m=m, k=k, c=c, k_s=k_s, c_s=c_s, f0=f0, g=g, omega=omega, eta_hat=eta_hat).items()}
     for name in ("m", "g", "k"):
         if vals[name] <= 0:
             raise ParameterError(f"{name}: must be > 0, got {vals[name]}")
