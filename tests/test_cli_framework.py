@@ -103,7 +103,7 @@ def test_plot_without_suffix_prints_the_file_written(tmp_path):
     assert (tmp_path / "noext.png").read_bytes()[:4] == b"\x89PNG"
 
 
-NOTICE = "compiling numba kernels (first run only, two to four minutes)..."
+NOTICE = "compiling numba kernels (first run only, three to five minutes)..."
 
 
 def test_first_run_compilation_is_announced_once(tmp_path):

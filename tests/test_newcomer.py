@@ -143,3 +143,62 @@ def test_bad_options_are_refused_before_the_kernels_load(tmp_path):
     assert codes == [2] * len(cases), (codes, r.stderr)
     assert [ln for ln in r.stderr.splitlines() if ln.strip()][0].startswith("error: periods:")
     assert not loaded, "a command imported the kernels before refusing a bad option"
+
+
+def test_every_command_refuses_bad_options_before_the_kernels_load(tmp_path):
+    """The same for the commands the first fix left: lyapunov, orbit, continue (its two-
+    parameter and extended forms), manifolds, eta-study, limit-cycle, equilibria and
+    surface-bifurcation, and the tolerances and section phase of every command (checked by
+    ``kernels.Solver`` before, now by the light ``checks.check_solver_options`` it calls)."""
+    import json
+    import subprocess
+    import sys
+    bad = str(tmp_path / "missing" / "x.nc")
+    sb = ["surface-bifurcation", "--param", "v_belt", "--from", "0.1", "--to", "0.2"]
+    cases = [
+        (["lyapunov", "--blocks", "1"], "blocks: must be >= 2"),
+        (["lyapunov", "--rtol", "2"], "rtol: must satisfy 0 < rtol < 1"),
+        (["orbit", "--tol", "-1"], "tol: must be > 0"),
+        (["orbit", "--show", "X,Q"], "show: unknown component 'Q'"),
+        (["orbit", "--atol", "0"], "atol: must satisfy"),
+        (["continue", "--param", "omega", "--step", "-1"], "step: must be > 0"),
+        (["continue", "--param", "omega", "-o", bad], "output: cannot write"),
+        (["continue", "--param", "omega", "--two-param", "F0", "--values", "0.1", "0.2", "1"],
+         "steps: must be >= 2"),
+        (["continue", "--param", "omega", "--two-param", "F0", "--extended", "sideways"],
+         "extended: expected 'up' or 'down'"),
+        (["continue", "--model", "stick_slip", "--param", "v_belt", "--section", "V +"],
+         "section: cannot read 'V +'"),
+        (["manifolds", "--point", "1"], "point: a period-1 orbit has section points 0 ... 0"),
+        (["manifolds", "--axes", "X,X"], "axes: two different components"),
+        (["manifolds", "--x", "1", "0"], "x: expected finite low < high"),
+        (["eta-study", "--eta", "0.7", "-o", "a.nc"], "eta: every value must satisfy"),
+        (["eta-study", "--eta", "0.1", "--record", "0", "-o", "a.nc"], "record: must be >= 2"),
+        (["limit-cycle", "--transient", "0"], "transient: must be >= 1"),
+        (["limit-cycle", "--direction", "sideways"], "section: direction must be one of"),
+        (["limit-cycle", "--section", "Q + 1"], "section: unknown name(s) Q"),
+        (["limit-cycle", "--set", "F0=0.5"], "limit_cycle: the system is forced"),
+        (["equilibria", "-o", bad], "output: cannot write"),
+        (["equilibria", "--param", "v_belt", "--from", "1", "--to", "1"], "from/to: empty"),
+        (sb + ["--crossings", "0"], "crossings: must be >= 2"),
+        (sb + ["--section", "X +* 1"], "section: cannot read"),
+        (["simulate", "--rtol", "0", "-o", "a.nc"], "rtol: must satisfy"),
+        (["poincare", "--section-phase", "7", "-o", "a.nc"], "section_phase: must satisfy"),
+        (["map", "--atol", "2", "-o", "a.nc"], "atol: must satisfy"),
+    ]
+    code = ("import sys, json, io, contextlib\nfrom nonsmooth.cli import main\nout = []\n"
+            f"for argv in {[c[0] for c in cases]!r}:\n"
+            "    err = io.StringIO()\n"
+            "    with contextlib.redirect_stderr(err):\n"
+            "        try:\n            main(argv)\n            c = 0\n"
+            "        except SystemExit as e:\n            c = e.code\n"
+            "    out.append([c, 'nonsmooth.kernels' in sys.modules, err.getvalue()])\n"
+            "print(json.dumps(out))\n")
+    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                       cwd=tmp_path, timeout=300)
+    got = json.loads(r.stdout.strip().splitlines()[-1])
+    for (argv, msg), (c, loaded, err) in zip(cases, got):
+        lines = [ln for ln in err.splitlines() if ln.strip()]
+        assert c == 2 and len(lines) == 1 and lines[0].startswith("error: ") and msg in lines[0], \
+            (argv, c, err)
+        assert not loaded, f"{argv} imported the kernels before refusing a bad option"

@@ -37,6 +37,65 @@ def check_float(name: str, value) -> float:
     return v
 
 
+def check_positive(name: str, value) -> float:
+    """``value`` as a finite float > 0, else a one-line ParameterError naming ``name``."""
+    v = check_float(name, value)
+    if not v > 0:
+        raise ParameterError(f"{name}: must be > 0, got {v:g}")
+    return v
+
+
+def check_window(x, v):
+    """A window ((x_lo, x_hi), (v_lo, v_hi)) of two state components, or None for neither;
+    one-line ParameterErrors name ``x`` or ``v``."""
+    if x is None and v is None:
+        return None
+    if x is None or v is None:
+        raise ParameterError("x: give both x and v (the window), or neither")
+    out = []
+    for name, r in (("x", x), ("v", v)):
+        try:
+            lo, hi = (float(b) for b in r)
+        except (TypeError, ValueError):
+            raise ParameterError(f"{name}: expected (low, high), got {r!r}") from None
+        if not (math.isfinite(lo) and math.isfinite(hi) and lo < hi):
+            raise ParameterError(f"{name}: expected finite low < high, got ({lo:g}, {hi:g})")
+        out.append((lo, hi))
+    return tuple(out)
+
+
+def check_solver_options(rtol=1e-8, atol=1e-10, section_phase=0.0) -> float:
+    """The integration tolerances (0 < rtol, atol < 1) and the section's forcing phase
+    (0 <= psi < 2 pi, radians) of a ``kernels.Solver``; returns the phase as a float."""
+    for name, v in (("rtol", rtol), ("atol", atol)):
+        if not (isinstance(v, (int, float)) and math.isfinite(v) and 0 < v < 1):
+            raise ParameterError(f"{name}: must satisfy 0 < {name} < 1, got {v!r}")
+    ph = section_phase
+    if isinstance(ph, bool) or not isinstance(ph, (int, float, np.floating, np.integer)) \
+            or not (math.isfinite(ph) and 0.0 <= ph < 2.0 * math.pi):
+        raise ParameterError(f"section_phase: must satisfy 0 <= section_phase < 2 pi "
+                             f"(radians), got {ph!r}")
+    return float(ph)
+
+
+def check_etas(etas) -> np.ndarray:
+    """The eta values as a float array; one-line ParameterError naming ``eta`` otherwise."""
+    if etas is None or isinstance(etas, (str, bytes)):
+        raise ParameterError(f"eta: expected a list of band half-widths, got {etas!r}")
+    try:
+        vals = [float(e) for e in np.atleast_1d(np.asarray(etas, dtype=object)).ravel()]
+    except (TypeError, ValueError):
+        raise ParameterError(f"eta: expected numbers, got {etas!r}") from None
+    if not vals:
+        raise ParameterError("eta: give at least one value (0 < eta < 0.5)")
+    for v in vals:
+        if not (math.isfinite(v) and 0.0 < v < 0.5):
+            raise ParameterError(f"eta: every value must satisfy 0 < eta < 0.5, got {v!r}")
+    if len(set(vals)) != len(vals):
+        raise ParameterError(f"eta: values must be distinct, got {vals}")
+    return np.array(vals, dtype=np.float64)
+
+
 def check_params(params) -> ParamsBase:
     """``params`` if it is a model's validated parameters (``model(...).params(...)``,
     ``preset(...)``), else a one-line ParameterError."""

@@ -20,6 +20,7 @@ from dataclasses import dataclass
 import numba as nb
 import numpy as np
 
+from .checks import check_solver_options
 from .errors import ParameterError
 import warnings
 
@@ -178,18 +179,10 @@ class Solver:
         from .models import model as get_model
         object.__setattr__(self, "model", get_model(self.model or DEFAULT_MODEL))
         self.model.method(self.method)  # one-line error for an unknown method
-        for name in ("rtol", "atol"):
-            v = getattr(self, name)
-            if not (isinstance(v, (int, float)) and math.isfinite(v) and 0 < v < 1):
-                raise ParameterError(f"{name}: must satisfy 0 < {name} < 1, got {v!r}")
+        ph = check_solver_options(self.rtol, self.atol, self.section_phase)
         if not (isinstance(self.max_steps, int) and self.max_steps > 0):
             raise ParameterError(f"max_steps: must be a positive integer, got {self.max_steps!r}")
-        ph = self.section_phase
-        if isinstance(ph, bool) or not isinstance(ph, (int, float, np.floating, np.integer)) \
-                or not (math.isfinite(ph) and 0.0 <= ph < 2.0 * math.pi):
-            raise ParameterError(f"section_phase: must satisfy 0 <= section_phase < 2 pi "
-                                 f"(radians), got {ph!r}")
-        object.__setattr__(self, "section_phase", float(ph))
+        object.__setattr__(self, "section_phase", ph)
 
     @property
     def spec(self):

@@ -35,6 +35,7 @@ import math
 import numpy as np
 import xarray as xr
 
+from ..checks import check_etas  # noqa: F401 (re-exported)
 from ..errors import ParameterError
 from ..io import provenance_attrs
 from ..kernels import Solver, new_state
@@ -48,24 +49,6 @@ MAX_PERIOD = 64
 #: settled periodic orbit repeats to ~1e-13, so this is far from both round-off and chaos).
 EXACT_RTOL = 1e-10
 EXACT_ATOL = 1e-12
-
-
-def check_etas(etas) -> np.ndarray:
-    """The eta values as a float array; one-line ParameterError naming ``eta`` otherwise."""
-    if etas is None or isinstance(etas, (str, bytes)):
-        raise ParameterError(f"eta: expected a list of band half-widths, got {etas!r}")
-    try:
-        vals = [float(e) for e in np.atleast_1d(np.asarray(etas, dtype=object)).ravel()]
-    except (TypeError, ValueError):
-        raise ParameterError(f"eta: expected numbers, got {etas!r}") from None
-    if not vals:
-        raise ParameterError("eta: give at least one value (0 < eta < 0.5)")
-    for v in vals:
-        if not (math.isfinite(v) and 0.0 < v < 0.5):
-            raise ParameterError(f"eta: every value must satisfy 0 < eta < 0.5, got {v!r}")
-    if len(set(vals)) != len(vals):
-        raise ParameterError(f"eta: values must be distinct, got {vals}")
-    return np.array(vals, dtype=np.float64)
 
 
 def _check_count(name, value, minimum):

@@ -57,11 +57,12 @@ import xarray as xr
 
 from .. import status as st
 from ..errors import ParameterError
+from ..checks import check_positive, check_window
 from ..integrate.contract import ST_EXTRA, ST_V, ST_X
 from ..io import apply_state_units, component_names, components, provenance_attrs
 from ..kernels import new_state, output_buffers, run
 from ..models.base import KERNEL_GENERIC
-from ..simulate import check_float, check_int, check_params, component_variables
+from ..simulate import check_int, check_params, component_variables
 from ..tangent import TangentSetup
 from .basins import _check_axes
 from .basins._core import _map_points, _one_interval
@@ -450,30 +451,6 @@ def _stable_branch(mp: _Map, start, zs, e_s, Einv, sign, delta, spacing, max_ang
 
 
 # ---- the analysis ------------------------------------------------------------------------------
-def _check_window(x, v):
-    if x is None and v is None:
-        return None
-    if x is None or v is None:
-        raise ParameterError("x: give both x and v (the window), or neither")
-    out = []
-    for name, r in (("x", x), ("v", v)):
-        try:
-            lo, hi = (float(b) for b in r)
-        except (TypeError, ValueError):
-            raise ParameterError(f"{name}: expected (low, high), got {r!r}") from None
-        if not (math.isfinite(lo) and math.isfinite(hi) and lo < hi):
-            raise ParameterError(f"{name}: expected finite low < high, got ({lo:g}, {hi:g})")
-        out.append((lo, hi))
-    return tuple(out)
-
-
-def _positive(name, value):
-    value = check_float(name, value)
-    if not value > 0:
-        raise ParameterError(f"{name}: must be > 0, got {value:g}")
-    return value
-
-
 def _centred(params, orbit, point):
     """``orbit`` with its section point ``point`` first: Newton shooting from it (converged
     there already) gives that point's monodromy."""
@@ -592,23 +569,23 @@ def manifolds(params, orbit, *, x=None, v=None, spacing: float | None = None,
     if m.autonomous:
         raise ParameterError(f"manifolds: model {m.name} declares no forcing; the manifolds "
                              f"here are those of the stroboscopic map")
-    window = _check_window(x, v)
+    window = check_window(x, v)
     plane = list(_check_axes(m, axes, None)[:2])
     orbit = _centred(params, orbit, point)
     solver, setup, k, p, zs, act, mu, E = _saddle(params, orbit)
     diag = (math.hypot(window[0][1] - window[0][0], window[1][1] - window[1][0])
             if window else None)
-    spacing = (_positive("spacing", spacing) if spacing is not None
+    spacing = (check_positive("spacing", spacing) if spacing is not None
                else diag / 200.0 if diag else 0.01 * (1.0 + float(np.linalg.norm(zs[plane]))))
-    delta = _positive("delta", delta) if delta is not None else spacing / 1000.0
-    max_angle = _positive("max_angle", max_angle)
-    length = (_positive("length", length) if length is not None
+    delta = check_positive("delta", delta) if delta is not None else spacing / 1000.0
+    max_angle = check_positive("max_angle", max_angle)
+    length = (check_positive("length", length) if length is not None
               else 4.0 * diag if diag else 100.0 * spacing)
     iterates = check_int("iterates", iterates, 1) if iterates is not None else None
     max_points = check_int("max_points", max_points, 3)
     max_search = check_int("max_search", max_search, 1)
-    radius = _positive("radius", radius) if radius is not None else 5.0 * spacing
-    tol = _positive("tol", tol) if tol is not None else spacing * 1e-4
+    radius = check_positive("radius", radius) if radius is not None else 5.0 * spacing
+    tol = check_positive("tol", tol) if tol is not None else spacing * 1e-4
     iu = int(np.flatnonzero(np.abs(mu) > 1.0)[0])
     mu_u = float(mu[iu].real)
     q = k if mu_u > 0 else 2 * k
@@ -824,7 +801,7 @@ def homoclinic_tangency(params, orbit, param: str, bounds, *, tol: float = 1e-4,
         raise ParameterError(f"bounds: expected (a, b), got {bounds!r}") from None
     if not (math.isfinite(a) and math.isfinite(b) and a != b):
         raise ParameterError(f"bounds: expected two different finite values, got {bounds!r}")
-    tol = _positive("tol", tol)
+    tol = check_positive("tol", tol)
     import inspect
     known = set(inspect.signature(manifolds).parameters) - {"params", "orbit", "stable",
                                                              "progress"}

@@ -36,7 +36,7 @@ def _terminate(signum, frame):
 def _compile_notice() -> None:
     # the same rule as the progress bars (sweep.Progress): on a terminal, or when asked for
     if os.environ.get("NONSMOOTH_PROGRESS", "") == "1" or sys.stderr.isatty():
-        typer.echo("compiling numba kernels (first run only, two to four minutes)...", err=True)
+        typer.echo("compiling numba kernels (first run only, three to five minutes)...", err=True)
 
 
 def interrupted_message(code: int) -> str:

@@ -110,7 +110,7 @@ def poincare_cmd(
     """Stroboscopic Poincaré map (t = kT) with period and contact classification; plot like
     Figs. 10 and 12 (phase portrait with its section points, and the map)."""
     params = load_params(preset, set_, model, "table3", method=method)
-    from ..checks import check_int
+    from ..checks import check_int, check_solver_options
     if points is not None:  # deprecated name
         record = check_int("points", points, 1)
     method = resolve_method(params, method)
@@ -120,6 +120,7 @@ def poincare_cmd(
     from ..plot.common import check_show
     pair = check_show(show, params.model.state_names)
     require_output(out, plot)
+    check_solver_options(rtol, atol, section_phase)
     check_outputs(out, plot)
     from ..analysis.poincare import poincare  # (after the checks: the kernels load with it)
     with _progress("poincare") as prog:
@@ -172,7 +173,7 @@ def bifurcation_cmd(
 ):
     """Bifurcation diagram of the section X(kT) over a parameter (Figs. 9 and 11)."""
     params = load_params(preset, set_, model, "table3", method=method)
-    from ..checks import SWEEPS, check_int
+    from ..checks import SWEEPS, check_int, check_solver_options
     method = resolve_method(params, method)
     preset = preset_label(params, preset, "table3")
     from ..checks import check_forced
@@ -188,6 +189,7 @@ def bifurcation_cmd(
     check_int("transient", transient, 0)
     check_int("record", record, 1)
     require_output(out, plot)
+    check_solver_options(rtol, atol, section_phase)
     check_outputs(out, plot)
     from ..analysis.bifurcation import bifurcation_diagram  # (after the checks)
     store, engine = chunk_store(out, dask)
@@ -233,7 +235,7 @@ def resonance_cmd(
     """Resonance curve (max X, min X versus omega, swept up and down with continuation) and
     the frequencies omega_a (contact starts), omega_b, omega_c (jumps), like Fig. 6."""
     params = load_params(preset, set_, model, "fig6a", method=method)
-    from ..checks import check_int
+    from ..checks import check_int, check_solver_options
     method = resolve_method(params, method)
     preset = preset_label(params, preset, "fig6a")
     from ..checks import check_forced
@@ -246,6 +248,7 @@ def resonance_cmd(
     check_int("transient", transient, 0)
     check_int("record", record, 1)
     require_output(out, plot)
+    check_solver_options(rtol, atol, section_phase)
     check_outputs(out, plot)
     from ..analysis.resonance import resonance_curve  # (after the checks)
     store, engine = chunk_store(out, dask)

@@ -32,6 +32,16 @@ def _method(params, method):
     return resolve_method(params, method)
 
 
+def _check_flow(params, section, direction, rtol, atol, max_time):
+    """The section surface, the tolerances and max_time of a command on a section, checked
+    before the kernels load (the analysis checks them again)."""
+    from ..checks import check_positive, check_solver_options
+    from ..section_surface import parse_section
+    parse_section(params, (section, direction))
+    check_solver_options(rtol, atol)
+    check_positive("max_time", max_time)
+
+
 @app.command("limit-cycle")
 def limit_cycle_cmd(
     model: ModelOpt = "stick_slip",
@@ -55,11 +65,17 @@ def limit_cycle_cmd(
     Newton shooting on a section surface: its period, section point and nontrivial Floquet
     multipliers. Exit status 1 when no cycle was found."""
     params = load_params(preset, set_, model, method=method)
-    from ..analysis.autonomous import limit_cycle
+    from ..checks import check_int, check_positive
     from ..io import components
     method = _method(params, method)
     preset = preset_label(params, preset, None)
+    from ..section_surface import check_autonomous
+    check_autonomous(params, "limit_cycle")
+    _check_flow(params, section, direction, rtol, atol, max_time)
+    check_int("transient", transient, 1)
+    check_positive("tol", tol)
     check_outputs(out, None)
+    from ..analysis.autonomous import limit_cycle  # (after the checks: the kernels load with it)
     ds = limit_cycle(params, (section, direction), x0=x0, v0=v0, u0=u0, transient=transient,
                      method=method, tol=tol, rtol=rtol, atol=atol, max_time=max_time)
     a = ds.attrs
@@ -104,13 +120,19 @@ def equilibria_cmd(
     eigenvalues; with --param, the first one followed along a parameter with its Hopf
     points."""
     params = load_params(preset, set_, model, method=method)
-    from ..analysis.autonomous import equilibria, equilibrium_branch
     from ..errors import ParameterError
     from ..io import components
     from .analyses import value_range
     method = _method(params, method)
     preset = preset_label(params, preset, None)
+    from ..section_surface import check_autonomous
+    check_autonomous(params, "equilibria" if param is None else "equilibrium_branch")
     check_outputs(out, None)
+    if param is not None:
+        if from_ is None or to is None:
+            raise ParameterError("from: --param needs --from and --to")
+        values = value_range(from_, to, steps, f"{param} range")
+    from ..analysis.autonomous import equilibria, equilibrium_branch  # (after the checks)
     if param is None:
         ds = equilibria(params, method=method)
         rows = []
@@ -126,9 +148,6 @@ def equilibria_cmd(
         if not rows:
             typer.echo(f"{preset}: no equilibrium found")
     else:
-        if from_ is None or to is None:
-            raise ParameterError("from: --param needs --from and --to")
-        values = value_range(from_, to, steps, f"{param} range")
         ds = equilibrium_branch(params, param, values, method=method)
         hopf = ds[f"hopf_{ds.attrs['param']}"].values
         typer.echo(f"{preset}: equilibrium in mode "
@@ -173,22 +192,27 @@ def surface_bifurcation_cmd(
     their crossings per turn, and values that come to rest. A self-excited system, or a forced
     one (an impact map on a switching surface, with the forcing phase: --show phase)."""
     params = load_params(preset, set_, model, method=method)
-    from ..analysis.autonomous import surface_bifurcation_diagram
-    from ..plot.autonomous import plot_surface_bifurcation
+    from ..checks import check_int
     from ..plot.common import check_show
     from .analyses import value_range
     method = _method(params, method)
     preset = preset_label(params, preset, None)
+    params.model.param(param)
+    _check_flow(params, section, direction, rtol, atol, max_time)
+    check_int("crossings", crossings, 2)
+    check_int("transient", transient, 0)
     check_outputs(out, plot)
     if show == "phase":
-        from ..analysis.autonomous import is_forced
         from ..errors import ParameterError
+        from ..section_surface import is_forced
         if not is_forced(params):
             raise ParameterError("show: phase: only a forced system's crossings have a forcing "
                                  "phase")
     elif show is not None:
         check_show(f"{show},{show}", params.model.state_names)
     values = value_range(from_, to, steps, f"{param} range")
+    from ..analysis.autonomous import surface_bifurcation_diagram  # (after the checks)
+    from ..plot.autonomous import plot_surface_bifurcation
     ds = surface_bifurcation_diagram(params, param, values, (section, direction),
                                      crossings=crossings, transient=transient, x0=x0, v0=v0,
                                      u0=u0, method=method, rtol=rtol, atol=atol,

@@ -51,6 +51,8 @@ def basins_cmd(
     method = resolve_method(params, method)
     preset = preset_label(params, preset, "fig7")
     require_output(out, plot if plot is not None else orbits_plot or entropy_plot)
+    from ..checks import check_solver_options
+    check_solver_options(rtol, atol, section_phase)
     check_outputs(out, plot, orbits_plot=orbits_plot, entropy_plot=entropy_plot)
     entropy = entropy or entropy_plot is not None
     if entropy:
@@ -139,6 +141,8 @@ def attractors_cmd(
     for val in (values[0], values[-1]):
         params.replace(**{param: float(val)})
     require_output(out, plot)
+    from ..checks import check_solver_options
+    check_solver_options(rtol, atol)
     check_outputs(out, plot)
     from ..analysis.attractor_continuation import attractor_continuation  # (after the checks)
     from ..sweep import Progress

@@ -111,8 +111,7 @@ def continue_cmd(
     unstable dashed. With --section (or a model without forcing): the limit cycles of a
     self-excited system on that section surface, their periods unknowns."""
     params = load_params(preset, set_, model, "fig6a", method=method or "exact")
-    from ..analysis.continuation import continuation
-    from ..checks import check_float, check_int
+    from ..checks import check_float, check_int, check_positive, check_solver_options
     if method is None and "exact" in params.model.methods:
         method = "exact"
     method = resolve_method(params, method)
@@ -128,12 +127,18 @@ def continue_cmd(
     if max_step is not None and not check_float("max_step", max_step) >= step:
         raise ParameterError(f"max_step: must be >= step ({step:g}), got {max_step:g}")
     bounds = _check_bounds(bounds)
+    check_positive("tol", tol)
+    check_positive("max_time", max_time)
+    check_solver_options(rtol, atol, section_phase)
     lam0 = float(getattr(params, param))
     if bounds is not None and not bounds[0] <= lam0 <= bounds[1]:
         raise ParameterError(f"bounds: {bounds[0]:g} ... {bounds[1]:g} exclude the start "
                              f"{param} = {lam0:g} (set it with --set {param}=VALUE)")
     cycles = section is not None or params.model.autonomous
     sec = (section or "V", crossing) if cycles else None
+    if sec is not None:
+        from ..section_surface import parse_section
+        parse_section(params, sec)  # (a one-line error before the kernels load)
     if extended is not None and values is not None:
         raise ParameterError("values: --extended follows the curve itself; give --bounds2, "
                              "not --values")
@@ -148,6 +153,7 @@ def continue_cmd(
                               step, bounds, max_points, method, tol, out, plot, section_phase,
                               u0, direction, sec, max_time)
     check_outputs(out, plot)
+    from ..analysis.continuation import continuation  # (after the checks: the kernels load)
     ds = continuation(params, param, k=k, x0=x0, v0=v0, u0=u0, transient=transient,
                       direction=direction, step=step, max_step=max_step, bounds=bounds,
                       max_points=max_points, method=method, tol=tol, rtol=rtol, atol=atol,
@@ -189,8 +195,6 @@ def _two_parameter(params, preset, param, param2, values, special, k, x0, v0, st
     """``nonsmooth continue --two-param``: the curve of --special points in (param, param2)."""
     import numpy as np
 
-    from ..analysis.continuation import two_parameter_curve
-    from ..plot.continuation import plot_two_parameter
     from .analyses import value_range
 
     params.model.param(param2)
@@ -198,6 +202,8 @@ def _two_parameter(params, preset, param, param2, values, special, k, x0, v0, st
         raise ParameterError("values: --two-param needs --values FROM TO N")
     grid = value_range(values[0], values[1], values[2], f"{param2} values", field="values")
     check_outputs(out, plot)
+    from ..analysis.continuation import two_parameter_curve  # (after the checks)
+    from ..plot.continuation import plot_two_parameter
     ds = two_parameter_curve(params, param, param2, grid, special=special, k=k, x0=x0, v0=v0,
                              u0=u0,
                              bounds=bounds, step=step, max_points=max_points, method=method,
@@ -219,17 +225,11 @@ def _extended(params, preset, param, param2, special, way, bounds2, k, x0, v0, u
     """``nonsmooth continue --two-param P2 --extended up|down``: the branch's first fold (or
     period doubling, or grazing) continued as an extended system (``fold_curve``,
     ``period_doubling_curve``, ``grazing_curve``)."""
-    from ..analysis.continuation import continuation
-    from ..analysis.fold_curve import (fold_curve, grazing_curve, neimark_sacker_curve,
-                                       period_doubling_curve)
-    from ..plot.continuation import plot_special_curve
-
     if param2 is None:
         raise ParameterError("extended: --extended needs --two-param (the second parameter)")
     if way not in ("up", "down"):
         raise ParameterError(f"extended: expected 'up' or 'down', got {way!r}")
-    curves = {"fold": fold_curve, "period_doubling": period_doubling_curve,
-              "grazing": grazing_curve, "neimark_sacker": neimark_sacker_curve}
+    curves = ("fold", "period_doubling", "grazing", "neimark_sacker")
     if special not in curves:
         raise ParameterError(f"special: --extended follows fold, period_doubling, "
                              f"neimark_sacker or grazing, got {special!r}")
@@ -237,11 +237,14 @@ def _extended(params, preset, param, param2, special, way, bounds2, k, x0, v0, u
         raise ParameterError("extended: limit cycles on a section are not supported here")
     p2 = params.model.param(param2).name
     check_outputs(out, plot)
+    from ..analysis import fold_curve  # (after the checks: the kernels load with it)
+    from ..analysis.continuation import continuation
+    from ..plot.continuation import plot_special_curve
     br = continuation(params, param, k=k, x0=x0, v0=v0, u0=u0, transient=transient,
                       direction=direction, step=step, max_step=max_step, bounds=bounds,
                       max_points=max_points, method=method, tol=tol, rtol=rtol, atol=atol,
                       section_phase=section_phase, max_time=max_time)
-    ds = curves[special](params, param, p2, start=br, direction=way, step=step,
+    ds = getattr(fold_curve, f"{special}_curve")(params, param, p2, start=br, direction=way, step=step,
                          max_step=max_step, bounds=bounds, bounds2=bounds2,
                          max_points=max_points, tol=max(tol, 1e-9), rtol=rtol, atol=atol)
     save_outputs(ds, preset, out, plot, plot_special_curve)

@@ -68,15 +68,23 @@ def eta_study_cmd(
     The values are audited from the largest to the smallest."""
     import math
 
-    from ..analysis.eta_study import check_etas, eta_study
+    from ..checks import check_etas, check_float, check_int, check_solver_options
 
     record = points if points is not None else record  # deprecated names
     orbit_periods = portrait_periods if portrait_periods is not None else orbit_periods
     etas = sorted(check_etas(parse_etas(list(eta or []) + list(more or []))), reverse=True)
     params = load_params(preset, set_, model, "fig4")
     preset = preset_label(params, preset, "fig4")
+    check_int("transient", transient, 0)
+    check_int("record", record, 2)
+    check_int("orbit_periods", orbit_periods, 1)
+    check_int("samples_per_period", samples_per_period, 1)
+    if not check_float("distance_tol", distance_tol) >= 0:
+        raise ParameterError(f"distance_tol: must be >= 0, got {distance_tol}")
+    check_solver_options(rtol, atol)
     require_output(out, plot)
     check_outputs(out, plot)
+    from ..analysis.eta_study import eta_study  # (after the checks: the kernels load with it)
     store, engine = chunk_store(out, dask)
     with _progress("eta study") as prog:
         ds = eta_study(params, etas, transient=transient, record=record,

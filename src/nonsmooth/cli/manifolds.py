@@ -9,6 +9,7 @@ from typing import Annotated, Optional
 
 import typer
 
+from ..errors import ParameterError
 from .analyses import V0Opt, X0Opt
 from .app import app
 from .common import (DEFAULT_MODEL, AtolOpt, ModelOpt, OutOpt, PlotOpt, PresetOpt, RtolOpt,
@@ -58,16 +59,28 @@ def manifolds_cmd(
     homoclinic points, and a figure over the basins (--basins-grid). Exit status 1 when no
     orbit was found from the start, 2 when the orbit found is not a saddle."""
     params = load_params(preset, set_, model, "fig7", method=method or "exact")
-    from ..analysis.manifolds import BRANCH_NAMES, manifolds
-    from ..analysis.stability import periodic_orbit
-    from ..checks import check_int
+    from ..checks import (check_int, check_positive, check_solver_options, check_window,
+                          component_pair)
     if method is None and "exact" in params.model.methods:
         method = "exact"
     method = resolve_method(params, method)
     preset = preset_label(params, preset, "fig7")
     check_int("k", k, 1)
+    if check_int("point", point, 0) >= k:
+        raise ParameterError(f"point: a period-{k} orbit has section points 0 ... {k - 1}, "
+                             f"got {point}")
     grid = check_int("basins_grid", basins_grid, 0)
+    check_window(x, v)
+    for name, val in (("spacing", spacing), ("length", length)):
+        if val is not None:
+            check_positive(name, val)
+    if axes is not None and len(set(component_pair(axes, params.model.state_names,
+                                                   "axes"))) != 2:
+        raise ParameterError(f"axes: two different components are needed, got {axes!r}")
+    check_solver_options(rtol, atol, section_phase)
     check_outputs(out, plot)
+    from ..analysis.manifolds import BRANCH_NAMES, manifolds  # (after the checks)
+    from ..analysis.stability import periodic_orbit
     orbit = periodic_orbit(params, k=k, x0=x0, v0=v0, u0=u0, method=method, rtol=rtol,
                            atol=atol, section_phase=section_phase)
     if orbit.attrs["status"] != "converged":

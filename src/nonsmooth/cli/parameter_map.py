@@ -71,6 +71,8 @@ def map_cmd(
                                  f"MAX N")
         y = ("F0", 0.15, 0.45, 100)
     require_output(out, plot if plot is not None else lambda_plot)
+    from ..checks import check_solver_options
+    check_solver_options(rtol, atol, section_phase)
     check_outputs(out, plot, lambda_plot=lambda_plot)
     from ..analysis.parameter_map import parameter_map, regimes  # (after the checks)
     store, engine = chunk_store(out, dask)

@@ -22,7 +22,7 @@ def reproduce_cmd(
     quick: Annotated[bool, typer.Option(
         "--quick/--full", metavar="", help="coarse grids, short runs (about 15 s once "
                                            "the kernels are compiled; the first run on a "
-                                           "machine compiles them, 2 to 4 minutes), or full "
+                                           "machine compiles them, 3 to 5 minutes), or full "
                                            "resolution")] = False,
     workers: WorkersOpt = None,
 ):

@@ -41,8 +41,9 @@ def simulate_cmd(
     from ..plot.common import check_show
     pair = check_show(show, params.model.state_names)
     require_output(out, plot)
+    from ..checks import check_int, check_solver_options  # (here before the kernels load)
+    check_solver_options(rtol, atol, section_phase)
     check_outputs(out, plot)
-    from ..checks import check_int  # (checked again by simulate: here before the kernels load)
     check_int("periods", periods, 1)
     check_int("transient", transient, 0)
     if samples_per_period is not None:

@@ -76,14 +76,15 @@ def lyapunov_cmd(
     equations with saltation matrices): exponents per unit time and per forcing period with
     standard errors, their sum and a verdict (chaotic, quasi-periodic, not settled)."""
     params = load_params(preset, set_, model, "table3", method=method)
-    from ..analysis.stability import lyapunov
-    from ..checks import check_int
+    from ..checks import check_int, check_solver_options
     method = resolve_method(params, method)
     preset = preset_label(params, preset, "table3")
     check_int("periods", periods, 1)
     check_int("transient", transient, 0)
     check_int("blocks", blocks, 2)
+    check_solver_options(rtol, atol, section_phase)
     check_outputs(out, plot)
+    from ..analysis.stability import lyapunov  # (after the checks: the kernels load with it)
     with _progress("lyapunov") as prog:
         ds = lyapunov(params, periods=periods, transient=transient, x0=x0, v0=v0, u0=u0,
                       method=method, rtol=rtol, atol=atol, section_phase=section_phase, blocks=blocks, progress=prog)
@@ -128,8 +129,7 @@ def orbit_cmd(
     points, Floquet multipliers, stability, max/min X and contact fraction; a phase portrait
     with the multipliers (in the plane --show names). Exit status 1 when no orbit was found."""
     params = load_params(preset, set_, model, "fig7", method=method or "exact")
-    from ..analysis.stability import periodic_orbit
-    from ..checks import check_int
+    from ..checks import check_int, check_positive, check_solver_options
     if method is None and "exact" in params.model.methods:
         method = "exact"
     method = resolve_method(params, method)
@@ -137,9 +137,12 @@ def orbit_cmd(
     check_int("k", k, 1)
     check_int("transient", transient, 0)
     check_int("max_iter", max_iter, 1)
+    check_positive("tol", tol)
+    check_solver_options(rtol, atol, section_phase)
     check_outputs(out, plot)
     from ..plot.common import check_show
     pair = check_show(show, params.model.state_names)
+    from ..analysis.stability import periodic_orbit  # (after the checks)
     ds = periodic_orbit(params, k=k, x0=x0, v0=v0, u0=u0, method=method, transient=transient,
                         tol=tol, max_iter=max_iter, rtol=rtol, atol=atol,
                       section_phase=section_phase)
