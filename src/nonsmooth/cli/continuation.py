@@ -244,9 +244,10 @@ def _extended(params, preset, param, param2, special, way, bounds2, k, x0, v0, u
                       direction=direction, step=step, max_step=max_step, bounds=bounds,
                       max_points=max_points, method=method, tol=tol, rtol=rtol, atol=atol,
                       section_phase=section_phase, max_time=max_time)
-    ds = getattr(fold_curve, f"{special}_curve")(params, param, p2, start=br, direction=way, step=step,
-                         max_step=max_step, bounds=bounds, bounds2=bounds2,
-                         max_points=max_points, tol=max(tol, 1e-9), rtol=rtol, atol=atol)
+    curve = getattr(fold_curve, f"{special}_curve")  # fold_curve, period_doubling_curve, ...
+    ds = curve(params, param, p2, start=br, direction=way, step=step, max_step=max_step,
+               bounds=bounds, bounds2=bounds2, max_points=max_points, tol=max(tol, 1e-9),
+               rtol=rtol, atol=atol)
     save_outputs(ds, preset, out, plot, plot_special_curve)
     a, b = ds[param].values, ds[p2].values
     typer.echo(f"{preset} ({method}): {special.replace('_', ' ')} of the period-{k} branch at "
