@@ -201,7 +201,7 @@ MODEL = Model(
         "exact": Method(exact_field, exact_jacobian, exact_guards, exact_transition,
                         exact_initial, modes=(FREE, CONTACT), flow_is_homeomorphism=True,
                         rtol=1e-12, atol=1e-14,
-                        description="event-driven free flight and contact, RKF45 at rtol "
+                        description="event-driven free flight and contact, DOP853 at rtol "
                                     "1e-12 (nonlinear modes)"),
         "smooth": Method(smooth_field, smooth_jacobian, smooth_guards, smooth_transition,
                          smooth_initial, modes=(FREE, CONTACT), flow_is_homeomorphism=True,

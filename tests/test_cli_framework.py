@@ -70,6 +70,30 @@ def test_sigterm_takes_the_same_path_and_leaves_the_old_file(tmp_path):
     assert sorted(p.name for p in tmp_path.iterdir()) == ["r.nc"]
 
 
+def test_a_second_sigterm_while_the_first_unwinds_changes_nothing(tmp_path):
+    """A newcomer's ``timeout 30`` (with its harness) sent SIGTERM twice: the second one, raised
+    while the first was being reported, ended in a traceback. Now it is ignored: one line,
+    exit 143."""
+    driver = DRIVER.format(stage="simulate", argv=["simulate", "-o", "r.nc"]).replace(
+        "from nonsmooth.cli import main\n",
+        "import nonsmooth.cli as cli\nslow = cli.interrupted_message\n"
+        "def report(code):\n    print('unwinding', flush=True)\n    time.sleep(2)\n"
+        "    return slow(code)\ncli.interrupted_message = report\nmain = cli.main\n")
+    proc = popen([sys.executable, "-c", driver], stdout=subprocess.PIPE,
+                 stderr=subprocess.PIPE, text=True, cwd=tmp_path)
+    try:
+        assert proc.stdout.readline().strip() == "ready"
+        proc.send_signal(signal.SIGTERM)
+        assert proc.stdout.readline().strip() == "unwinding"
+        proc.send_signal(signal.SIGTERM)
+        out, err = proc.communicate(timeout=SAFETY_S)
+    finally:
+        proc.kill()
+    assert proc.returncode == 143, err
+    assert err.splitlines() == ["terminated: saved nothing; lost the computation in progress; "
+                                "no partial result written; r.nc not written"]
+
+
 def _cli(*args, cwd=None, **env):
     return subprocess.run([sys.executable, "-m", "nonsmooth.cli", *args], capture_output=True,
                           text=True, cwd=cwd, timeout=300, env={**os.environ, **env})

@@ -148,8 +148,9 @@ def test_bad_options_are_refused_before_the_kernels_load(tmp_path):
 def test_every_command_refuses_bad_options_before_the_kernels_load(tmp_path):
     """The same for the commands the first fix left: lyapunov, orbit, continue (its two-
     parameter and extended forms), manifolds, eta-study, limit-cycle, equilibria and
-    surface-bifurcation, and the tolerances and section phase of every command (checked by
-    ``kernels.Solver`` before, now by the light ``checks.check_solver_options`` it calls)."""
+    surface-bifurcation; the grids, windows, axes and map axes of basins, attractors and map;
+    and the tolerances and section phase of every command (checked by ``kernels.Solver``
+    before, now by the light ``checks.check_solver_options`` it calls)."""
     import json
     import subprocess
     import sys
@@ -185,6 +186,16 @@ def test_every_command_refuses_bad_options_before_the_kernels_load(tmp_path):
         (["simulate", "--rtol", "0", "-o", "a.nc"], "rtol: must satisfy"),
         (["poincare", "--section-phase", "7", "-o", "a.nc"], "section_phase: must satisfy"),
         (["map", "--atol", "2", "-o", "a.nc"], "atol: must satisfy"),
+        # a newcomer's fresh machine: these waited for the compile (basins --grid 1: 360 s),
+        # and attractors left its a.nc.chunks behind
+        (["basins", "--grid", "1", "-o", "a.nc"], "grid: must be >= 2"),
+        (["basins", "--x", "3", "-3", "-o", "a.nc"], "x: empty or reversed range"),
+        (["basins", "--axes", "X,Q", "-o", "a.nc"], "axes: unknown component 'Q'"),
+        (["map", "--x", "omega", "1.0", "0.8", "10", "-o", "a.nc"], "x: empty or reversed"),
+        (["map", "--x", "omega", "0.8", "1.0", "0", "-o", "a.nc"], "x n: must be >= 1"),
+        (["map", "--start", "sideways", "-o", "a.nc"], "start: expected one of"),
+        (["attractors", "--grid", "0", "-o", "a.nc"], "grid: must be >= 2"),
+        (["attractors", "--v", "1", "1", "-o", "a.nc"], "v: empty or reversed range"),
     ]
     code = ("import sys, json, io, contextlib\nfrom nonsmooth.cli import main\nout = []\n"
             f"for argv in {[c[0] for c in cases]!r}:\n"
@@ -202,3 +213,4 @@ def test_every_command_refuses_bad_options_before_the_kernels_load(tmp_path):
         assert c == 2 and len(lines) == 1 and lines[0].startswith("error: ") and msg in lines[0], \
             (argv, c, err)
         assert not loaded, f"{argv} imported the kernels before refusing a bad option"
+    assert not (tmp_path / "a.nc.chunks").exists()

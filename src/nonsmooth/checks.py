@@ -13,6 +13,8 @@ from .models.base import ParamsBase
 
 #: the sweep directions of ``bifurcation_diagram``
 SWEEPS = ("up", "down", "both", "fresh")
+#: the starts of ``parameter_map``
+STARTS = ("fresh", "continued")
 
 
 def check_int(name: str, value, minimum: int) -> int:
@@ -94,6 +96,60 @@ def check_etas(etas) -> np.ndarray:
     if len(set(vals)) != len(vals):
         raise ParameterError(f"eta: values must be distinct, got {vals}")
     return np.array(vals, dtype=np.float64)
+
+
+def check_range(name: str, r) -> tuple[float, float]:
+    """A (min, max) pair of finite numbers with min < max (a grid's window), else a one-line
+    ParameterError naming ``name``."""
+    try:
+        lo, hi = r
+    except (TypeError, ValueError):
+        raise ParameterError(f"{name}: expected a (min, max) pair, got {r!r}") from None
+    lo = check_float(f"{name} min", lo)
+    hi = check_float(f"{name} max", hi)
+    if not hi > lo:
+        raise ParameterError(f"{name}: empty or reversed range ({lo:g}, {hi:g}); need min < max")
+    return lo, hi
+
+
+def check_grid(grid) -> tuple[int, int]:
+    """(nx, nv) of a grid of initial conditions given as an int or a pair, each >= 2."""
+    if isinstance(grid, (tuple, list, np.ndarray)):
+        if len(grid) != 2:
+            raise ParameterError(f"grid: expected an int or an (nx, nv) pair, got {grid!r}")
+        return check_int("grid nx", grid[0], 2), check_int("grid nv", grid[1], 2)
+    g = check_int("grid", grid, 2)
+    return g, g
+
+
+def check_axes(model, axes) -> tuple[int, int]:
+    """The indices of the two different state components ``axes`` names ("X,Y" or a pair;
+    None: the first two) of ``model``; a one-line ParameterError naming ``axes`` otherwise."""
+    names = model.state_names
+    parts = component_pair(axes, names, "axes") or names[:2]
+    ia, ib = (names.index(a) for a in parts)
+    if ia == ib:
+        raise ParameterError(f"axes: two different components are needed, got {axes!r}")
+    return ia, ib
+
+
+def check_axis(name: str, axis, params: ParamsBase):
+    """(parameter, values) of an axis given as (name, lo, hi, n); one line naming ``name``
+    for anything else (an unknown parameter, an empty or reversed range, n < 1)."""
+    try:
+        pname, lo, hi, n = axis
+    except (TypeError, ValueError):
+        raise ParameterError(f"{name}: expected (parameter, min, max, n), got {axis!r}") from None
+    if not isinstance(pname, str):
+        raise ParameterError(f"{name}: expected a parameter name first, got {pname!r}")
+    pname = params.model.param(pname).name
+    lo = check_float(f"{name} min", lo)
+    hi = check_float(f"{name} max", hi)
+    n = check_int(f"{name} n", n, 1)
+    if hi < lo or (hi == lo and n > 1):
+        raise ParameterError(f"{name}: empty or reversed range {pname} = {lo:g} ... {hi:g}; "
+                             f"need min < max (or n = 1 and min = max)")
+    return pname, np.linspace(lo, hi, n)
 
 
 def check_params(params) -> ParamsBase:

@@ -881,14 +881,14 @@ def surface_basins(params, section="V", *, x=(-1.0, 1.0), v=(-1.0, 1.0), grid=20
     compiled kernel): for grids of hundreds of points, not of a million."""
     from ..simulate import check_int, initial_u, state_from_u, state_u
     from ..sweep import progress_callback
-    from .basins import _check_grid, _check_range
+    from ..checks import check_grid, check_range
     from ..kernels import run
     progress = progress_callback(progress, "surface_basins")
     params, solver, flow, text = _setup(params, section, method, rtol, atol, max_time,
                                         "surface_basins")
-    x_lo, x_hi = _check_range("x", x)
-    v_lo, v_hi = _check_range("v", v)
-    nx, nv = _check_grid(grid)
+    x_lo, x_hi = check_range("x", x)
+    v_lo, v_hi = check_range("v", v)
+    nx, nv = check_grid(grid)
     transient = check_int("transient", transient, 0)
     record = check_int("record", record, 2)
     max_period = check_int("max_period", max_period, 1)

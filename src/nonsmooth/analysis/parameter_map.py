@@ -25,11 +25,11 @@ import math
 import numpy as np
 import xarray as xr
 
+from ..checks import STARTS, check_axis  # noqa: F401 (re-exported)
 from ..errors import ParameterError
 from ..kernels import Solver
 from ..models.base import ParamsBase
 
-STARTS = ("fresh", "continued")
 #: Points per chunk of a fresh map: at least MAP_CHUNK, and at most MAX_CHUNKS chunks.
 MAP_CHUNK = 1024
 MAX_CHUNKS = 4000
@@ -41,26 +41,6 @@ OUTPUTS = {"period": np.int32, "max_X": np.float64, "min_X": np.float64, "contac
 LYAPUNOV_OUTPUTS = {"lambda1": np.float64, "lambda1_stderr": np.float64, "motion": np.int8}
 #: Bytes per grid point of the output arrays (memory check).
 _BYTES_PER_POINT = 64
-
-
-def check_axis(name: str, axis, params: ParamsBase):
-    """(parameter, values) of an axis given as (name, lo, hi, n); one line naming ``name``
-    for anything else (an unknown parameter, an empty or reversed range, n < 1)."""
-    from ..simulate import check_float, check_int
-    try:
-        pname, lo, hi, n = axis
-    except (TypeError, ValueError):
-        raise ParameterError(f"{name}: expected (parameter, min, max, n), got {axis!r}") from None
-    if not isinstance(pname, str):
-        raise ParameterError(f"{name}: expected a parameter name first, got {pname!r}")
-    pname = params.model.param(pname).name
-    lo = check_float(f"{name} min", lo)
-    hi = check_float(f"{name} max", hi)
-    n = check_int(f"{name} n", n, 1)
-    if hi < lo or (hi == lo and n > 1):
-        raise ParameterError(f"{name}: empty or reversed range {pname} = {lo:g} ... {hi:g}; "
-                             f"need min < max (or n = 1 and min = max)")
-    return pname, np.linspace(lo, hi, n)
 
 
 def _layout(ny: int, nx: int, start: str, chunk: int | None = None):

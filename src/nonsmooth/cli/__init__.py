@@ -30,6 +30,10 @@ from . import manifolds  # noqa: E402,F401
 from . import explore  # noqa: E402,F401
 
 def _terminate(signum, frame):
+    # a second SIGTERM while the first unwinds (``timeout``, then a harness, or a supervisor
+    # repeating it) is ignored: it would otherwise break the line on what was saved with a
+    # traceback; ``main`` restores the previous handler
+    signal.signal(signal.SIGTERM, signal.SIG_IGN)
     raise Terminated()
 
 

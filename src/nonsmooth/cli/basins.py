@@ -51,7 +51,14 @@ def basins_cmd(
     method = resolve_method(params, method)
     preset = preset_label(params, preset, "fig7")
     require_output(out, plot if plot is not None else orbits_plot or entropy_plot)
-    from ..checks import check_solver_options
+    from ..checks import check_axes, check_grid, check_int, check_range, check_solver_options
+    check_range("x", x)
+    check_range("v", v)
+    check_grid(grid)
+    check_int("transient", transient, 0)
+    check_int("max_periods", max_periods, 1)
+    check_int("max_period", max_period, 1)
+    check_axes(params.model, axes)
     check_solver_options(rtol, atol, section_phase)
     check_outputs(out, plot, orbits_plot=orbits_plot, entropy_plot=entropy_plot)
     entropy = entropy or entropy_plot is not None
@@ -141,7 +148,13 @@ def attractors_cmd(
     for val in (values[0], values[-1]):
         params.replace(**{param: float(val)})
     require_output(out, plot)
-    from ..checks import check_solver_options
+    from ..checks import check_grid, check_int, check_positive, check_range, check_solver_options
+    check_range("x", x)
+    check_range("v", v)
+    check_grid(grid)
+    check_int("max_periods", max_periods, 1)
+    if match_tol is not None:
+        check_positive("match_tol", match_tol)
     check_solver_options(rtol, atol)
     check_outputs(out, plot)
     from ..analysis.attractor_continuation import attractor_continuation  # (after the checks)

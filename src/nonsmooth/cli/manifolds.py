@@ -59,8 +59,8 @@ def manifolds_cmd(
     homoclinic points, and a figure over the basins (--basins-grid). Exit status 1 when no
     orbit was found from the start, 2 when the orbit found is not a saddle."""
     params = load_params(preset, set_, model, "fig7", method=method or "exact")
-    from ..checks import (check_int, check_positive, check_solver_options, check_window,
-                          component_pair)
+    from ..checks import (check_axes, check_int, check_positive, check_solver_options,
+                          check_window)
     if method is None and "exact" in params.model.methods:
         method = "exact"
     method = resolve_method(params, method)
@@ -74,9 +74,7 @@ def manifolds_cmd(
     for name, val in (("spacing", spacing), ("length", length)):
         if val is not None:
             check_positive(name, val)
-    if axes is not None and len(set(component_pair(axes, params.model.state_names,
-                                                   "axes"))) != 2:
-        raise ParameterError(f"axes: two different components are needed, got {axes!r}")
+    check_axes(params.model, axes)
     check_solver_options(rtol, atol, section_phase)
     check_outputs(out, plot)
     from ..analysis.manifolds import BRANCH_NAMES, manifolds  # (after the checks)

@@ -7,6 +7,7 @@ from typing import Annotated, Optional
 
 import typer
 
+from ..errors import ParameterError
 from .analyses import SettleOpt, TransientOpt, X0Opt, V0Opt, _progress
 from .app import app
 from .common import (U0Opt, DEFAULT_MODEL, SectionPhaseOpt, AtolOpt, DaskOpt, MethodOpt, ModelOpt, OutOpt, PlotOpt, PresetOpt,
@@ -66,12 +67,19 @@ def map_cmd(
     x = tuple(x) if x is not None else (w, *params.model.forcing_range(0.8, 1.0), 100)
     if y is None:
         if "F0" not in params.model.param_names:
-            from ..errors import ParameterError
             raise ParameterError(f"y: model {params.model.name!r} has no F0; give --y PARAM MIN "
                                  f"MAX N")
         y = ("F0", 0.15, 0.45, 100)
     require_output(out, plot if plot is not None else lambda_plot)
-    from ..checks import check_solver_options
+    from ..checks import STARTS, check_axis, check_int, check_solver_options
+    if check_axis("x", x, params)[0] == check_axis("y", y, params)[0]:
+        raise ParameterError(f"y: the two axes need different parameters, both are {x[0]!r}")
+    if start not in STARTS:
+        raise ParameterError(f"start: expected one of {', '.join(STARTS)}, got {start!r}")
+    check_int("transient", transient, 0)
+    check_int("record", record, 1)
+    if chunk is not None:
+        check_int("chunk", chunk, 1)
     check_solver_options(rtol, atol, section_phase)
     check_outputs(out, plot, lambda_plot=lambda_plot)
     from ..analysis.parameter_map import parameter_map, regimes  # (after the checks)

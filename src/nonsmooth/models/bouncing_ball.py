@@ -53,6 +53,7 @@ PARAMETERS = (
 
 MODEL = model_from_equations(
     "bouncing_ball", states=("Z", "V"), parameters={p.name: p for p in PARAMETERS},
+    compile_now=False,  # (compiled at its first use: importing the model compiles nothing)
     methods={
         "exact": dict(
             modes={"flight": ["V", FLIGHT], "stuck": ["0", "0"]},

@@ -100,7 +100,8 @@ def model_from_equations(name: str, *, states, parameters, modes: dict | None = 
                          period: str | None = None, forcing_amplitude: str | None = None, description: str = "",
                          flow_is_homeomorphism: bool = False, closed_form: bool = True,
                          rtol: float | None = None, atol: float | None = None,
-                         admissible=None, contact_modes=(), memory=None, **model_kw) -> Model:
+                         admissible=None, contact_modes=(), memory=None,
+                         compile_now: bool = True, **model_kw) -> Model:
     """A :class:`Model` from equations (see the module documentation).
 
     ``states``: names, e.g. ``("X", "V")``. ``parameters``: ``{name: default}``,
@@ -134,7 +135,10 @@ def model_from_equations(name: str, *, states, parameters, modes: dict | None = 
     the tangent cannot follow a surface that moves with the state's memory), and a mode whose
     field uses a slot has no closed form. Other keywords
     (``state_units``, ``state_long_names``, ``presets``, ``contact_name``, ``lines``,
-    ``references``, ``check``, ...) go to :class:`Model` as they are.
+    ``references``, ``check``, ...) go to :class:`Model` as they are. ``compile_now``: compile
+    and sample-check every method when the derivation is new, so that a malformed model fails
+    at its definition (False, as the built-in models: at its first use; importing them then
+    compiles nothing).
 
     Every mistake (an expression that does not parse, an unknown name, a surface that is not
     affine or has no gradient, a mode that does not exist) is one ParameterError naming the
@@ -221,7 +225,7 @@ def model_from_equations(name: str, *, states, parameters, modes: dict | None = 
                   methods=built, omega=omega, period=period, forcing_amplitude=forcing_amplitude,
                   contact_modes=contact_modes, **model_kw)
     if fresh:
-        for mname in built:
+        for mname in built if compile_now else ():
             model.fns(mname)  # compile and sample-check now: a malformed model fails here
         _store_derivation(name, key, derived)
     return model

@@ -65,6 +65,7 @@ PARAMETERS = (
 
 MODEL = model_from_equations(
     "impact_2dof", states=("X", "V", "Y", "W"), parameters={p.name: p for p in PARAMETERS},
+    compile_now=False,  # (compiled at its first use: importing the model compiles nothing)
     methods={
         "exact": dict(
             modes={"free": ["V", PRIMARY, "W", SECONDARY],

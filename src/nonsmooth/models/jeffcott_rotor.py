@@ -70,6 +70,7 @@ PARAMETERS = (
 
 MODEL = model_from_equations(
     "jeffcott_rotor", states=("X", "V", "Y", "W"), parameters={p.name: p for p in PARAMETERS},
+    compile_now=False,  # (compiled at its first use: importing the model compiles nothing)
     methods={
         "exact": dict(
             modes={"free": ["V", FREE_X, "W", FREE_Y],

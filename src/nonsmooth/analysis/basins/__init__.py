@@ -109,13 +109,13 @@ import warnings
 import numpy as np
 import xarray as xr
 
-from ...errors import ParameterError
+from ...checks import check_axes, check_grid, check_range
 from ...integrate.contract import N_STATE
 from ...io import (apply_state_units, check_memory, flag_attrs, provenance_attrs,
                    status_flags)
 from ...kernels import Solver, new_state, output_buffers
 from ...models.base import ParamsBase
-from ...simulate import check_float, check_int, check_params, state_u
+from ...simulate import check_int, check_params, state_u
 from ...sweep import parallel_chunks, resolve_workers, threads
 from ..periodicity import section_tolerance
 from ._core import (_HOLD, _K, _N_REC, _Q, _RES, _RES_FAILED, _RES_NEW, _RUNNING, _STATUS,
@@ -199,9 +199,9 @@ def basins(params: ParamsBase, *, x=(-3.0, 3.0), v=(-3.0, 3.0), grid=400, method
     from ..stability import wants_lyapunov
     engine = check_engine(engine)
     params = check_params(params)
-    x_lo, x_hi = _check_range("x", x)
-    v_lo, v_hi = _check_range("v", v)
-    nx, nv = _check_grid(grid)
+    x_lo, x_hi = check_range("x", x)
+    v_lo, v_hi = check_range("v", v)
+    nx, nv = check_grid(grid)
     ia, ib, base = _check_axes(params.model, axes, u0)
     transient = check_int("transient", transient, 0)
     max_periods = check_int("max_periods", max_periods, 1)
@@ -450,37 +450,12 @@ def _check_axes(model, axes, u0):
     """(ia, ib, base) of ``axes`` (two state component names) and ``u0``: base is empty for
     the plain grid in (X, V) of a two-component model (the compiled path of old), else the
     full start state u (the axes' values replaced per grid point)."""
-    from ...simulate import component_pair, initial_u
-    names = model.state_names
-    parts = component_pair(axes, names, "axes") or names[:2]
-    ia, ib = (names.index(a) for a in parts)
-    if ia == ib:
-        raise ParameterError(f"axes: two different components are needed, got {axes!r}")
+    from ...simulate import initial_u
+    ia, ib = check_axes(model, axes)
     u = initial_u(model, 0.0, 0.0, u0)
     if model.n == 2 and (ia, ib) == (0, 1) and u0 is None:
         return ia, ib, np.zeros(0)
     return ia, ib, u
-
-
-def _check_range(name, r):
-    try:
-        lo, hi = r
-    except (TypeError, ValueError):
-        raise ParameterError(f"{name}: expected a (min, max) pair, got {r!r}") from None
-    lo = check_float(f"{name} min", lo)
-    hi = check_float(f"{name} max", hi)
-    if not hi > lo:
-        raise ParameterError(f"{name}: empty or reversed range ({lo:g}, {hi:g}); need min < max")
-    return lo, hi
-
-
-def _check_grid(grid):
-    if isinstance(grid, (tuple, list, np.ndarray)):
-        if len(grid) != 2:
-            raise ParameterError(f"grid: expected an int or an (nx, nv) pair, got {grid!r}")
-        return check_int("grid nx", grid[0], 2), check_int("grid nv", grid[1], 2)
-    g = check_int("grid", grid, 2)
-    return g, g
 
 
 def _sample_orbits(found, solver, pk, spp):
