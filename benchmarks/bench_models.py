@@ -295,6 +295,10 @@ def rate_scipy(model, params, method, periods, repeat):
     """(periods/s best of ``repeat``, events, nfev) of the scipy event loop."""
     same = SameModel(model, params, method)
     t_end = periods * 2.0 * math.pi / same.om
+    # an untimed period first: it compiles the curved-guard caller (jeffcott_rotor: about
+    # 0.15 s, which a single timed run of 10 periods counted as scipy's, 1.8-3x its time, up
+    # to 2026-11-30) and loads the probes of ``_probe`` from numba's cache
+    same.integrate(2.0 * math.pi / same.om, SCIPY[method])
     best, n_ev, nfev = math.inf, 0, 0
     for _ in range(repeat):
         t0 = time.process_time()
