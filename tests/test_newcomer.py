@@ -214,3 +214,22 @@ def test_every_command_refuses_bad_options_before_the_kernels_load(tmp_path):
             (argv, c, err)
         assert not loaded, f"{argv} imported the kernels before refusing a bad option"
     assert not (tmp_path / "a.nc.chunks").exists()
+
+
+def test_a_sweep_refused_inside_its_chunks_leaves_no_store(tmp_path, capsys, monkeypatch):
+    """A newcomer's refused ``attractors --grid 0 -o a.nc`` left ``a.nc.chunks/`` (a lock and
+    a manifest) behind: its basins refused the grid inside the sweep's first chunk. The CLI
+    now checks the grid first; and a refusal that still comes from inside a chunk removes a
+    store with no finished chunk."""
+    import nonsmooth.analysis.basins as basins_module
+
+    def refuse(*args, **kwargs):
+        raise ParameterError("grid: refused inside the chunk")
+
+    monkeypatch.setattr(basins_module, "basins", refuse)
+    monkeypatch.chdir(tmp_path)
+    code, out, err = run_cli(["attractors", "--steps", "2", "--grid", "2", "--workers", "1",
+                              "-o", "a.nc"], capsys)
+    assert code == 2
+    one_line(err, "grid: refused inside the chunk")
+    assert sorted(p.name for p in tmp_path.iterdir()) == []
