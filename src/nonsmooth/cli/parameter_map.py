@@ -72,8 +72,9 @@ def map_cmd(
         y = ("F0", 0.15, 0.45, 100)
     require_output(out, plot if plot is not None else lambda_plot)
     from ..checks import STARTS, check_axis, check_int, check_solver_options
-    if check_axis("x", x, params)[0] == check_axis("y", y, params)[0]:
-        raise ParameterError(f"y: the two axes need different parameters, both are {x[0]!r}")
+    xname = check_axis("x", x, params)[0]
+    if check_axis("y", y, params)[0] == xname:
+        raise ParameterError(f"y: the two axes need different parameters, both are {xname!r}")
     if start not in STARTS:
         raise ParameterError(f"start: expected one of {', '.join(STARTS)}, got {start!r}")
     check_int("transient", transient, 0)
