@@ -95,6 +95,10 @@ def test_eta_zero_is_accepted_for_the_exact_method(capsys, tmp_path):
     # the file says that the eta it carries (the preset's) is not read by the exact method
     assert ds.attrs["unused_parameters"] == "eta"
     assert "unused_parameters" not in ns.simulate(ns.preset("table3"), periods=1).attrs
+    # and that its rtol, atol (recorded as asked) are not read either: its closed form is
+    # exact to round-off, event times located to 2e-14 max(1, T)
+    assert "rtol and atol are not used" in ds.attrs["integrator"]
+    assert "not used" not in ns.simulate(ns.preset("table3"), periods=1).attrs["integrator"]
     # still refused for the smoothed model, and not a number is still an error
     code, _, err = run_cli(["simulate", "--preset", "table3", "--set", "eta=0", "--periods", "2",
                             "-o", str(tmp_path / "s.nc")], capsys)

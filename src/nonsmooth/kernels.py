@@ -244,7 +244,8 @@ class Solver:
         if self.code == KERNEL_SUPPORT_SMOOTH:
             a["integrator"] = smooth_integrator()
         elif self.code == KERNEL_SUPPORT_EXACT:
-            a["integrator"] = "closed form between located switching events"
+            a["integrator"] = ("closed form between located switching events (event times to "
+                               "2e-14 max(1, T); rtol and atol are not used)")
         else:
             a["integrator"] = m.description or generic_integrator(m.closed_form)
         return a

@@ -125,9 +125,9 @@ def attractor_continuation(params, param: str, values, *, x=(-3.0, 3.0), v=(-3.0
     vals = _check_values(p.name, values)
     for w in (vals[0], vals[-1]):
         params.replace(**{p.name: float(w)})  # a value out of the parameter's range: one line
-    if match_tol is not None and not (isinstance(match_tol, (int, float))
-                                      and math.isfinite(match_tol) and match_tol > 0):
-        raise ParameterError(f"match_tol: a positive distance, got {match_tol!r}")
+    if match_tol is not None:
+        from ..checks import check_positive
+        match_tol = check_positive("match_tol", match_tol)  # (the CLI's check, its message)
     if "lyapunov" in basins_kw:
         raise ParameterError("lyapunov: not an option here (each value's basins run without "
                              "the evidence; run basins at a value for it)")
