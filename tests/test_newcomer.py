@@ -112,13 +112,30 @@ def test_eta_zero_is_accepted_for_the_exact_method(capsys, tmp_path):
     assert "ignored" in " ".join(stdout.split())
 
 
+def _in_a_fresh_process(cases, cwd):
+    """[exit code, nonsmooth.kernels imported by then, stderr] of ``nonsmooth ARGV`` for each
+    argv of ``cases``, run one after the other in one fresh Python process."""
+    import json
+    import subprocess
+    import sys
+    code = ("import sys, json, io, contextlib\nfrom nonsmooth.cli import main\nout = []\n"
+            f"for argv in {list(cases)!r}:\n"
+            "    err = io.StringIO()\n"
+            "    with contextlib.redirect_stderr(err):\n"
+            "        try:\n            main(argv)\n            c = 0\n"
+            "        except SystemExit as e:\n            c = e.code\n"
+            "    out.append([c, 'nonsmooth.kernels' in sys.modules, err.getvalue()])\n"
+            "print(json.dumps(out))\n")
+    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=cwd,
+                       timeout=300)
+    return json.loads(r.stdout.strip().splitlines()[-1])
+
+
 def test_bad_options_are_refused_before_the_kernels_load(tmp_path):
     """A newcomer on a fresh machine waited 4-9 minutes (the kernels' first compile) for the
     one line refusing `--periods -5`, an unwritable `-o`, a reversed range, ...: the commands
     imported their analysis, and with it the kernels, before checking their own options. Now
     those are checked first: none of these imports ``nonsmooth.kernels`` (one fresh process)."""
-    import subprocess
-    import sys
     bad = tmp_path / "missing" / "x.nc"
     cases = [
         ["simulate", "--periods", "-5", "-o", "a.nc"],
@@ -136,17 +153,10 @@ def test_bad_options_are_refused_before_the_kernels_load(tmp_path):
         ["attractors", "--from", "1.2", "--to", "1.1", "-o", "a.nc"],
         ["map", "-o", str(bad)],
     ]
-    code = ("import sys, json\nfrom nonsmooth.cli import main\nout = []\n"
-            f"for argv in {cases!r}:\n"
-            "    try:\n        main(argv)\n    except SystemExit as e:\n        out.append(e.code)\n"
-            "print(json.dumps([out, 'nonsmooth.kernels' in sys.modules]))\n")
-    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
-                       cwd=tmp_path, timeout=300)
-    import json
-    codes, loaded = json.loads(r.stdout.strip().splitlines()[-1])
-    assert codes == [2] * len(cases), (codes, r.stderr)
-    assert [ln for ln in r.stderr.splitlines() if ln.strip()][0].startswith("error: periods:")
-    assert not loaded, "a command imported the kernels before refusing a bad option"
+    got = _in_a_fresh_process(cases, tmp_path)
+    assert [c for c, _, _ in got] == [2] * len(cases), got
+    assert [ln for ln in got[0][2].splitlines() if ln.strip()][0].startswith("error: periods:")
+    assert not got[-1][1], "a command imported the kernels before refusing a bad option"
 
 
 def test_every_command_refuses_bad_options_before_the_kernels_load(tmp_path):
@@ -155,9 +165,6 @@ def test_every_command_refuses_bad_options_before_the_kernels_load(tmp_path):
     surface-bifurcation; the grids, windows, axes and map axes of basins, attractors and map;
     and the tolerances and section phase of every command (checked by ``kernels.Solver``
     before, now by the light ``checks.check_solver_options`` it calls)."""
-    import json
-    import subprocess
-    import sys
     bad = str(tmp_path / "missing" / "x.nc")
     sb = ["surface-bifurcation", "--param", "v_belt", "--from", "0.1", "--to", "0.2"]
     cases = [
@@ -201,17 +208,7 @@ def test_every_command_refuses_bad_options_before_the_kernels_load(tmp_path):
         (["attractors", "--grid", "0", "-o", "a.nc"], "grid: must be >= 2"),
         (["attractors", "--v", "1", "1", "-o", "a.nc"], "v: empty or reversed range"),
     ]
-    code = ("import sys, json, io, contextlib\nfrom nonsmooth.cli import main\nout = []\n"
-            f"for argv in {[c[0] for c in cases]!r}:\n"
-            "    err = io.StringIO()\n"
-            "    with contextlib.redirect_stderr(err):\n"
-            "        try:\n            main(argv)\n            c = 0\n"
-            "        except SystemExit as e:\n            c = e.code\n"
-            "    out.append([c, 'nonsmooth.kernels' in sys.modules, err.getvalue()])\n"
-            "print(json.dumps(out))\n")
-    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
-                       cwd=tmp_path, timeout=300)
-    got = json.loads(r.stdout.strip().splitlines()[-1])
+    got = _in_a_fresh_process([argv for argv, _ in cases], tmp_path)
     for (argv, msg), (c, loaded, err) in zip(cases, got):
         lines = [ln for ln in err.splitlines() if ln.strip()]
         assert c == 2 and len(lines) == 1 and lines[0].startswith("error: ") and msg in lines[0], \

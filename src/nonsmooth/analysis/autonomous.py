@@ -45,6 +45,7 @@ import numpy as np
 import xarray as xr
 
 from .. import status as st
+from ..checks import check_positive
 from ..errors import IntegrationError, ParameterError
 from ..integrate.contract import ST_MODE
 from ..io import apply_state_units, provenance_attrs
@@ -198,15 +199,13 @@ def _start(params, solver, x0, v0, u0):
 
 
 def _setup(params, section, method, rtol, atol, max_time, who, forced_ok=False):
-    from ..simulate import check_float, check_params
+    from ..simulate import check_params
     params = check_params(params)
     solver = Solver(method=method, rtol=rtol, atol=atol, model=params.model)
     if not (forced_ok and is_forced(params)):
         check_autonomous(params, who, solver)
     surface = parse_section(params, section)
-    max_time = check_float("max_time", max_time)
-    if not max_time > 0:
-        raise ParameterError(f"max_time: must be > 0, got {max_time}")
+    max_time = check_positive("max_time", max_time)
     return params, solver, _Flow(params, solver, surface, max_time), surface.text
 
 
@@ -434,7 +433,7 @@ def limit_cycle(params, section="V", *, x0: float = 0.0, v0: float = 0.0, u0=Non
     itself to ``CONFIRM_TOL``; a point where the field vanishes (to ``EQUILIBRIUM_TOL``: the
     shooting converged onto an equilibrium that lies on the section, e.g. a stable focus) is
     no cycle: status "equilibrium: ...", not converged."""
-    from ..simulate import check_float, check_int, start_attrs
+    from ..simulate import check_int, start_attrs
     from .stability import _section_state, damped_step
     params, solver, flow, text = _setup(params, section, method, rtol, atol, max_time,
                                         "limit_cycle")
@@ -442,9 +441,7 @@ def limit_cycle(params, section="V", *, x0: float = 0.0, v0: float = 0.0, u0=Non
     max_iter = check_int("max_iter", max_iter, 1)
     samples = check_int("samples", samples, 2)
     crossings = check_int("crossings", crossings, 1)
-    tol = check_float("tol", tol)
-    if not tol > 0:
-        raise ParameterError(f"tol: must be > 0, got {tol}")
+    tol = check_positive("tol", tol)
     n = params.model.n
     u_start, s = _start(params, solver, x0, v0, u0)
     status, _, _, _, _ = flow.crossings(s, transient)

@@ -35,6 +35,7 @@ import numpy as np
 import xarray as xr
 
 from .. import status as st
+from ..checks import check_positive
 from ..errors import ParameterError
 from ..integrate.roots import illinois_point, illinois_update
 from ..io import apply_state_units, provenance_attrs
@@ -494,15 +495,11 @@ def branch_arguments(params, param, k, max_points, step, max_step, tol, directio
     param = params.model.param(param).name
     k = check_int("k", k, 1)
     max_points = check_int("max_points", max_points, 2)
-    step = check_float("step", step)
-    if not step > 0:
-        raise ParameterError(f"step: must be > 0, got {step}")
+    step = check_positive("step", step)
     max_step = 10.0 * step if max_step is None else check_float("max_step", max_step)
     if not max_step >= step:
         raise ParameterError(f"max_step: must be >= step = {step:g}, got {max_step:g}")
-    tol = check_float("tol", tol)
-    if not tol > 0:
-        raise ParameterError(f"tol: must be > 0, got {tol}")
+    tol = check_positive("tol", tol)
     if direction not in ("up", "down"):
         raise ParameterError(f"direction: expected 'up' or 'down', got {direction!r}")
     lam0 = float(getattr(params, param))

@@ -196,8 +196,8 @@ def resonance_curve(params: ParamsBase, omegas, *, method: str = "smooth", trans
     from ..sweep import progress_callback
     progress = progress_callback(progress, "resonance")
     from ..chunks import check_engine
-    from ..simulate import (check_admissible, check_float, check_int, check_params,
-                            initial_u, start_attrs)
+    from ..checks import check_positive
+    from ..simulate import check_admissible, check_int, check_params, initial_u, start_attrs
     params = check_params(params)
     engine = check_engine(engine)
     transient = check_int("transient", transient, 0)
@@ -208,12 +208,8 @@ def resonance_curve(params: ParamsBase, omegas, *, method: str = "smooth", trans
     for w in (omegas[0], omegas[-1]):
         params.replace(**{w_name: float(w)})
     u = initial_u(params.model, x0, v0, u0)
-    resolution = check_float("resolution", resolution)
-    if resolution <= 0:
-        raise ParameterError(f"resolution: must be > 0, got {resolution}")
-    branch_tol = check_float("branch_tol", branch_tol)
-    if branch_tol <= 0:
-        raise ParameterError(f"branch_tol: must be > 0, got {branch_tol}")
+    resolution = check_positive("resolution", resolution)
+    branch_tol = check_positive("branch_tol", branch_tol)
     if branches not in ("stable", "all"):
         raise ParameterError(f"branches: expected 'stable' or 'all', got {branches!r}")
     solver = Solver(method=method, rtol=rtol, atol=atol,

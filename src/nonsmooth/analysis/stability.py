@@ -24,13 +24,14 @@ import numpy as np
 import xarray as xr
 
 from .. import status as st
-from ..errors import IntegrationError, ParameterError
+from ..checks import check_positive
+from ..errors import IntegrationError
 from ..integrate.contract import OPT_NO_EXTREMA, ST_H, ST_MODE
 from ..io import apply_state_units, check_memory, provenance_attrs, state_long_name
 from ..kernels import mode_holds, output_buffers, run, tangent_function
 from ..models.base import KERNEL_GENERIC
-from ..simulate import (check_float, check_int, component_variables, start_attrs,
-                        start_trajectory, state_u)
+from ..simulate import (check_int, component_variables, start_attrs, start_trajectory,
+                        state_u)
 from ..tangent import TangentSetup, period_map
 
 #: Lyapunov verdicts (CF flag values of ``lyapunov_class``).
@@ -276,9 +277,7 @@ def periodic_orbit(params, *, k: int = 1, x0: float = 0.0, v0: float = 0.0,
     check_memory(_ORBIT_SAMPLE_BYTES * k * spp, big[0],
                  f"the orbit is k x samples_per_period = {k:,} x {spp:,} samples",
                  size=(big[1], 1))
-    tol = check_float("tol", tol)
-    if not tol > 0:
-        raise ParameterError(f"tol: must be > 0, got {tol}")
+    tol = check_positive("tol", tol)
     setup = TangentSetup(solver)
     N = setup.N
     if transient:

@@ -122,8 +122,7 @@ def continue_cmd(
     check_int("max_points", max_points, 2)
     if direction not in ("up", "down"):
         raise ParameterError(f"direction: expected 'up' or 'down', got {direction!r}")
-    if not check_float("step", step) > 0:
-        raise ParameterError(f"step: must be > 0, got {step:g}")
+    check_positive("step", step)
     if max_step is not None and not check_float("max_step", max_step) >= step:
         raise ParameterError(f"max_step: must be >= step ({step:g}), got {max_step:g}")
     bounds = _check_bounds(bounds)
