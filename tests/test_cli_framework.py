@@ -77,16 +77,16 @@ def test_a_second_sigterm_while_the_first_unwinds_changes_nothing(tmp_path):
     driver = DRIVER.format(stage="simulate", argv=["simulate", "-o", "r.nc"]).replace(
         "from nonsmooth.cli import main\n",
         "import nonsmooth.cli as cli\nslow = cli.interrupted_message\n"
-        "def report(code):\n    print('unwinding', flush=True)\n    time.sleep(2)\n"
+        "def report(code):\n    print('unwinding', flush=True)\n    sys.stdin.readline()\n"
         "    return slow(code)\ncli.interrupted_message = report\nmain = cli.main\n")
-    proc = popen([sys.executable, "-c", driver], stdout=subprocess.PIPE,
+    proc = popen([sys.executable, "-c", driver], stdin=subprocess.PIPE, stdout=subprocess.PIPE,
                  stderr=subprocess.PIPE, text=True, cwd=tmp_path)
     try:
         assert proc.stdout.readline().strip() == "ready"
         proc.send_signal(signal.SIGTERM)
         assert proc.stdout.readline().strip() == "unwinding"
-        proc.send_signal(signal.SIGTERM)
-        out, err = proc.communicate(timeout=SAFETY_S)
+        proc.send_signal(signal.SIGTERM)  # while the report waits for its go on stdin
+        out, err = proc.communicate(input="go\n", timeout=SAFETY_S)
     finally:
         proc.kill()
     assert proc.returncode == 143, err
