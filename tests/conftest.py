@@ -21,24 +21,42 @@ def pytest_xdist_auto_num_workers(config):
 
 
 def pytest_configure(config):
-    """On an empty numba cache, compile the slow kernels in subprocesses before the workers
-    start (otherwise every worker compiles the same kernels at once, one after the other within
-    each worker): the generic kernel, by far the longest (about two minutes), alone on one
-    core; on another, one after the other, the other kernels and then every built-in model's
-    compiled functions (and the derivations of the models written as equations), which every
-    worker would otherwise build for itself."""
+    """On an empty numba cache, compile what every worker would otherwise compile for itself,
+    in subprocesses, before the workers start: first the generic kernel, by far the longest
+    (about two to five minutes), alone on one core, and on the other, one after the other, the
+    other kernels and every built-in model's compiled functions (and the derivations of the
+    models written as equations); then, side by side, what importing the test modules compiles
+    (the kernels' dispatch and the analyses' compiled cores: each worker imports every test
+    module, the two at the same time) and the tests' own slow functions (``precompile()`` in
+    ``PRECOMPILED``)."""
     if hasattr(config, "workerinput") or not getattr(config.option, "numprocesses", None):
         return
     from nonsmooth import _numba_cache
     # the modules whose first compile takes minutes, less ``kernels``, which imports them
     todo = [m for m in _numba_cache.SLOW_MODULES
             if m != "kernels" and not _numba_cache.is_compiled(m)]
-    if not todo:
-        return
     longest = "integrate.hybrid"
     codes = [f"import nonsmooth.{longest}"] if longest in todo else []
-    codes.append("".join(f"import nonsmooth.{m}\n" for m in todo if m != longest)
-                 + _BUILTIN_MODELS)
+    if todo:
+        codes.append("".join(f"import nonsmooth.{m}\n" for m in todo if m != longest)
+                     + _BUILTIN_MODELS)
+    _side_by_side(codes)
+    if todo or not all(map(_numba_cache.is_compiled, ("kernels", "analysis.bifurcation"))):
+        here = os.path.dirname(os.path.abspath(__file__))
+        tests = sorted(f[:-3] for f in os.listdir(here)
+                       if f.startswith("test_") and f.endswith(".py"))
+        path = f"import sys\nsys.path.insert(0, {here!r})\n"
+        _side_by_side([path + "".join(f"import {m}\n" for m in tests),
+                       path + "".join(f"import {m}\n{m}.precompile()\n" for m in PRECOMPILED)])
+
+
+#: Test modules with a ``precompile()`` that compiles (or loads from the cache) their slow
+#: compiled functions.
+PRECOMPILED = ("test_hybrid_kernel",)
+
+
+def _side_by_side(codes):
+    """Run each code in a Python process of its own, all at once; wait for them all."""
     procs = [subprocess.Popen([sys.executable, "-c", code]) for code in codes]
     for p in procs:
         p.wait()

@@ -28,6 +28,13 @@ from nonsmooth.integrate.contract import (  # noqa: E402
     ST_X,
 )
 from nonsmooth.integrate.hybrid import _NS, _rk_step, _rk_tangent, advance_generic  # noqa: E402
+from nonsmooth._numba_cache import register_user_file  # noqa: E402
+from nonsmooth.models import file_digest  # noqa: E402
+
+# The RKF45 step with its tangent (``_rk_step_and_tangent``) takes 40-70 s to compile: it is
+# cached on disk like a user's model file (stamped with the kernels' sources and this file's
+# digest), compiled once before the workers start (``conftest.py``, ``precompile``).
+register_user_file(__file__, f"nonsmooth_tests_hybrid_kernel_{file_digest(__file__)}")
 
 pytestmark = pytest.mark.filterwarnings("ignore::numba.NumbaExperimentalFeatureWarning")
 
@@ -718,7 +725,7 @@ def coupled_jacobian(mode, t, c, s, u, p, mem, J):
     return 0
 
 
-@nb.njit(cache=False)
+@nb.njit(cache=True)
 def _rk_step_and_tangent(field, jacobian, u, mem, h, om, Y):
     """One RKF45 step of ``field`` from (tau, C, S) = (0.3, cos 0.7, sin 0.7) and its tangent
     (``hybrid._rk_tangent``, memory slot 1 continuous) applied to Y (rows: u, then slot 1).
@@ -738,6 +745,12 @@ def _rk_step_and_tangent(field, jacobian, u, mem, h, om, Y):
                 np.zeros(n), np.zeros((_NS, n, m)), np.zeros((n, n + 2)),
                 np.zeros((_NS, n, n + 2)), us, cmi, 1e-8, 1e-10)
     return u1
+
+
+def precompile():
+    """Compile (or load) ``_rk_step_and_tangent`` for the argument types of its tests."""
+    _rk_step_and_tangent(coupled_field, coupled_jacobian, np.zeros(2), np.array([1.0, 0.8]), 0.37,
+                         1.3, np.eye(3))
 
 
 @pytest.mark.parametrize("n", [2, 3, 4, 5])
