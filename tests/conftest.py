@@ -46,8 +46,11 @@ def pytest_configure(config):
         tests = sorted(f[:-3] for f in os.listdir(here)
                        if f.startswith("test_") and f.endswith(".py"))
         path = f"import sys\nsys.path.insert(0, {here!r})\n"
+        # (quiet: a test module that fails to import says so again, in its place, when the
+        # workers collect it)
         _side_by_side([path + "".join(f"import {m}\n" for m in tests),
-                       path + "".join(f"import {m}\n{m}.precompile()\n" for m in PRECOMPILED)])
+                       path + "".join(f"import {m}\n{m}.precompile()\n" for m in PRECOMPILED)],
+                      quiet=True)
 
 
 #: Test modules with a ``precompile()`` that compiles (or loads from the cache) their slow
@@ -55,9 +58,11 @@ def pytest_configure(config):
 PRECOMPILED = ("test_hybrid_kernel",)
 
 
-def _side_by_side(codes):
+def _side_by_side(codes, quiet=False):
     """Run each code in a Python process of its own, all at once; wait for them all."""
-    procs = [subprocess.Popen([sys.executable, "-c", code]) for code in codes]
+    out = subprocess.DEVNULL if quiet else None
+    procs = [subprocess.Popen([sys.executable, "-c", code], stdout=out, stderr=out)
+             for code in codes]
     for p in procs:
         p.wait()
 
