@@ -27,8 +27,8 @@ def pytest_configure(config):
     other kernels and every built-in model's compiled functions (and the derivations of the
     models written as equations); then, side by side, what importing the test modules compiles
     (the kernels' dispatch and the analyses' compiled cores: each worker imports every test
-    module, the two at the same time) and the tests' own slow functions (``precompile()`` in
-    ``PRECOMPILED``)."""
+    module the command names, the two at the same time) and the tests' own slow functions
+    (``precompile()`` of the modules in ``PRECOMPILED`` that the command names)."""
     if hasattr(config, "workerinput") or not getattr(config.option, "numprocesses", None):
         return
     from nonsmooth import _numba_cache
@@ -43,19 +43,33 @@ def pytest_configure(config):
     _side_by_side(codes)
     if todo or not all(map(_numba_cache.is_compiled, ("kernels", "analysis.bifurcation"))):
         here = os.path.dirname(os.path.abspath(__file__))
-        tests = sorted(f[:-3] for f in os.listdir(here)
-                       if f.startswith("test_") and f.endswith(".py"))
+        tests = _requested_modules(config.args, here)
         path = f"import sys\nsys.path.insert(0, {here!r})\n"
         # (quiet: a test module that fails to import says so again, in its place, when the
         # workers collect it)
         _side_by_side([path + "".join(f"import {m}\n" for m in tests),
-                       path + "".join(f"import {m}\n{m}.precompile()\n" for m in PRECOMPILED)],
+                       path + "".join(f"import {m}\n{m}.precompile()\n"
+                                      for m in PRECOMPILED if m in tests)],
                       quiet=True)
 
 
 #: Test modules with a ``precompile()`` that compiles (or loads from the cache) their slow
 #: compiled functions.
 PRECOMPILED = ("test_hybrid_kernel",)
+
+
+def _requested_modules(args, here):
+    """The test modules (names) that the command line's paths name: every one for a folder
+    that holds this one (``pytest``, ``pytest tests``), else those of the files named."""
+    every = sorted(f[:-3] for f in os.listdir(here) if f.startswith("test_") and f.endswith(".py"))
+    named = set()
+    for arg in args or ["."]:
+        path = os.path.abspath(arg.split("::")[0])
+        if os.path.isdir(path) and (here + os.sep).startswith(path.rstrip(os.sep) + os.sep):
+            return every
+        if os.path.dirname(path) == here and path.endswith(".py"):
+            named.add(os.path.basename(path)[:-3])
+    return [m for m in every if m in named]
 
 
 def _side_by_side(codes, quiet=False):
