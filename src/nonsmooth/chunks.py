@@ -366,7 +366,10 @@ def execute(plan: Plan, collect: Callable[[int, dict], None], *, store=None, eng
     chunk in its place). With ``store`` (a directory, see :class:`ChunkStore`) the
     finished chunks are written there and the chunks already there are read instead of
     computed. ``progress(done, total)`` counts ``plan.weights``. A Dask engine is connected
-    before the store is opened, so an unreachable scheduler leaves nothing behind."""
+    before the store is opened, so an unreachable scheduler leaves nothing behind; a run
+    refused or failed with a :class:`NonsmoothError` (an analysis refusing its input inside
+    a chunk) removes a store that holds no finished chunk (one with finished chunks stays, to
+    resume from)."""
     engine = check_engine(engine)
     with contextlib.ExitStack() as stack:
         client = stack.enter_context(dask_client(engine)) if engine is not None else None
@@ -374,7 +377,13 @@ def execute(plan: Plan, collect: Callable[[int, dict], None], *, store=None, eng
         if st is not None:
             stack.callback(st.close)
             active_stores.append((st.path, plan.n_chunks))
-        _execute(plan, collect, st, client, workers, progress)
+        try:
+            _execute(plan, collect, st, client, workers, progress)
+        except NonsmoothError:
+            if st is not None and saved_chunks(st.path) == 0:
+                stack.close()  # (its lock released first)
+                remove_store(st.path)
+            raise
 
 
 def _execute(plan, collect, st, client, workers, progress):

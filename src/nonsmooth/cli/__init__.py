@@ -68,16 +68,6 @@ def interrupted_message(code: int) -> str:
     return f"{what}: saved {saved}; lost {lost}"
 
 
-def _drop_empty_stores() -> None:
-    """Remove the chunk stores of a refused or failed run that hold no finished chunk (an
-    analysis that refused its input inside a sweep left ``<out>.chunks`` with only its lock and
-    manifest); a store with finished chunks stays, to resume from."""
-    from ..chunks import active_stores, remove_store, saved_chunks
-    for path, _ in active_stores:
-        if saved_chunks(path) == 0:
-            remove_store(path)
-
-
 def _resume_notice(path, done: int, total: int) -> None:
     typer.echo(f"resuming from {path}: {done} of {total} chunks already done", err=True)
 
@@ -119,11 +109,9 @@ def main(argv: list[str] | None = None) -> None:
         typer.echo(interrupted_message(exc.code), err=True)
         sys.exit(exc.code)
     except IntegrationError as exc:
-        _drop_empty_stores()
         typer.echo(f"error: {exc}", err=True)
         sys.exit(EXIT_NUMERICAL)
     except NonsmoothError as exc:
-        _drop_empty_stores()
         typer.echo(f"error: {exc}", err=True)
         sys.exit(EXIT_USAGE)
     finally:  # leave a calling process (tests, a notebook) as it was
