@@ -38,7 +38,8 @@ Design summary
   located: the mode switches at the end of the first step that ends past it, so that the
   region at every output is the side the state is on, at no cost to the steps; a pass and
   return inside a step that the Hermite of (g, g') at its ends shows marks the mode across as
-  visited.
+  visited. Its g and g' at a step's end are those of the next step's start (one evaluation of
+  ``curved`` per label and step), and the immediate-exit test at a step's start skips labels.
 * A guard with forcing terms (G[k, n+1], G[k, n+2]) is not a cubic along a step, and a step can
   be long (a stick phase has a zero error estimate, so its RKF45 steps grow to a whole output
   interval): its exit test is certified, and so is every guard on a closed-form piece (the
@@ -1006,6 +1007,17 @@ def _n_curved(G, ng, n):
 
 
 @nb.njit(cache=True, inline="always")
+def _exit_tested(G, ng, n, ksec):
+    """Whether a step start must test any of the ng guard rows for an immediate exit
+    (``_immediate_exit_curved``): every row but a curved label, which is switched at a step's
+    end (``contract``)."""
+    for k in range(ng):
+        if not (math.isnan(G[k, n]) and G[k, n + 1] == 1.0 and k != ksec):
+            return True
+    return False
+
+
+@nb.njit(cache=True, inline="always")
 def _finite(u, n):
     """Every one of u[0:n] is finite."""
     for i in range(n):
@@ -1766,7 +1778,9 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
     o += MAX_MODES * (CF_SLOTS + 1)
     # each affine guard's g and g' at the step's end, which are those at the next step's start
     # while ``gv`` (an accepted step without a switch in a mode whose guards are all affine and
-    # not a series piece's: the state, its derivative and the phase are copied from the end)
+    # not a series piece's: the state, its derivative and the phase are copied from the end);
+    # in a mode with curved guards, a curved label's g and g' at the step's end, the next
+    # step's start while ``lv`` and that start is the time they were taken at (``t_lv``)
     gc = view(ws, o, (MAX_GUARDS,))
     dc = view(ws, o + MAX_GUARDS, (MAX_GUARDS,))
     PW = view(ws, total, (MAX_MODES, m3 * m3, N_TAYLOR + 1))  # M^j / j! of each _MC_POLY mode
@@ -1844,6 +1858,7 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
             sgn = _section_side(G, ng, H, n, u, f0, C0, S0, om)
         ksec = ng
         ng += 1
+    imm = _exit_tested(G, ng, n, ksec)
     cls = _mode_class(linear, closed, mode, pp, lin, MC, mcs, om, MF, n, MXR, PW)
     if cls == _MC_RESONANT:
         _store(state, u, n, mem, nmem, mode, h)
@@ -1864,6 +1879,8 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
     n_tiny = 0
     t_switch = -1e300
     gv = False
+    lv = False
+    t_lv = 0.0
     tw_all = True
     j = 0
     for it in range(n_total):
@@ -1882,6 +1899,8 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
                         break
             elif ncv == 0:
                 k_tr = _immediate_exit(G, ng, n, u, f0, C, S, om)
+            elif not imm:
+                k_tr = -1  # (curved labels only)
             else:
                 k_tr = _immediate_exit_curved(curved, mode, tau, G, ng, n, u, f0, C, S, om, pp,
                                               mem, gr, ksec, SECTION_K + (sgn < 0.0))
@@ -1974,16 +1993,22 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
                         # ends past it; a pass and return inside the step that the Hermite of
                         # (g, g') at the step's ends shows is only a visit of the mode across
                         # (the visited mask), not a switch
+                        # (the start's g and g': the last step's end, kept while ``lv``)
+                        g0 = gc[k]
+                        d0 = dc[k]
                         g1, d1 = _curved_rate(curved, mode, k, tau + hs, C1, S1, n, u1, f1, pp,
                                               mem, gr)
+                        gc[k] = g1
+                        dc[k] = d1
                         if g1 < 0.0:
                             if 1.0 < s_best:
                                 s_best = 1.0
                                 s_lo = 1.0
                                 k_tr = k
                         else:
-                            g0, d0 = _curved_rate(curved, mode, k, tau, C, S, n, u, f0, pp, mem,
-                                                  gr)
+                            if not (lv and tau == t_lv):
+                                g0, d0 = _curved_rate(curved, mode, k, tau, C, S, n, u, f0, pp,
+                                                      mem, gr)
                             b1, b2, b3 = herm_coeffs(max(g0, 0.0), d0, g1, d1, hs)
                             r1, r2 = quad_roots01(b1, 2.0 * b2, 3.0 * b3)
                             for q in (r1, r2):
@@ -2203,11 +2228,15 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
                 C = C1
                 S = S1
                 gv = k_tr < 0 and not pm and not pd and ncv == 0
+                # (a visit across a label called ``transition``, which may write mem)
+                lv = k_tr < 0 and ncv > 0 and not (dip_k >= 0 and dip_s < s_best)
+                t_lv = tau + hs
                 tau = t_end if last else tau + hs
                 xmax = max(xmax, u[0])
                 xmin = min(xmin, u[0])
             if k_tr >= 0:
                 gv = False  # a reset, or the section row flips
+                lv = False
             if k_tr >= 0 and k_tr == ksec:
                 # ---- a crossing of the section surface: record it, flip the row ----
                 if SEC[0] == 0.0 or SEC[0] == -sgn:
@@ -2276,6 +2305,7 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
                     ng += 1
                     if csec:
                         ncv += 1
+                imm = _exit_tested(G, ng, n, ksec)
                 cls = int(mcs[mode])  # (known after the mode's first visit)
                 if cls == _MC_UNKNOWN:
                     cls = _mode_class(linear, closed, mode, pp, lin, MC, mcs, om, MF, n, MXR,
@@ -2311,6 +2341,7 @@ def _advance(fns, p, opts, state, per_period, n_skip, n_out, X_out, V_out, R_out
         if j == per_period:
             j = 0
             gv = False  # the phase restarts at (C0, S0), f0 is computed again
+            lv = False
             t_done += T
             tau = t0
             t_switch -= T
