@@ -267,6 +267,28 @@ def test_a_model_file_of_equations_runs_from_the_cli(tmp_path):
     assert r.returncode == 0, r.stderr
     ds = ns.io.load_dataset(tmp_path / "p.nc")
     assert int(ds.period) == 1 and ds.attrs["model"] == "impact_eq"
+    # its description says that it declares no contact (a newcomer read "contact: contact")
+    r = subprocess.run([sys.executable, "-m", "nonsmooth.cli", "models", f"{f}:MODEL"],
+                       capture_output=True, text=True, timeout=300)
+    assert r.returncode == 0 and "contact: not defined (no contact_modes" in r.stdout
+
+
+def test_a_forcing_frequency_or_period_given_as_a_plain_number_must_be_positive():
+    """A plain number's range is any finite value, but omega <= 0 (or T <= 0) frames no time:
+    one line naming it. (A newcomer's omega=0 reached the kernel, which ended the run as
+    'non-finite state'.)"""
+    by_period = ns.model_from_equations(
+        "plain_T", states=("X", "V"), parameters={"T": 5.0, "F0": 0.4},
+        modes={"free": ["V", "-X - 0.05*V + F0*cos(2*pi*t/T)"]}, period="T", method="exact",
+        compile_now=False)
+    for bad in (0.0, -1.5):
+        with pytest.raises(ParameterError, match=r"^omega: the forcing frequency must be > 0, "
+                                                 r"got " + f"{bad:g}$"):
+            impact_oscillator().params(omega=bad)
+        with pytest.raises(ParameterError, match=r"^T: the forcing period must be > 0"):
+            by_period.params(T=bad)
+    assert impact_oscillator().params(omega=0.5).omega == 0.5
+    assert by_period.params(T=2.0).T == 2.0
 
 
 def test_default_ranges_of_a_period_model_are_periods(tmp_path, capsys):

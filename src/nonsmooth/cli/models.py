@@ -14,6 +14,16 @@ def _value(v) -> str:
     return "required" if v is None else f"{v:g}"
 
 
+def _contact_line(m) -> str:
+    """What counts as contact in the results' ``contact`` variable of model ``m``."""
+    if m.contact is not None or m.contact_name != "contact":
+        return m.contact_name
+    if m.contact_modes:
+        return f"a visit of {m.contact_text}"
+    return ("not defined (no contact_modes or contact function declared: the results' "
+            "contact is 0)")
+
+
 def model_lines(name: str) -> list[str]:
     """One model in detail: parameters (default, range, units, long name), state, modes,
     methods, presets, references."""
@@ -33,7 +43,7 @@ def model_lines(name: str) -> list[str]:
                       zip(m.state_names, tuple(m.state_long_names) + ("",) * m.n))
     out += ["", f"state: {state}",
             "modes: " + ", ".join(f"{i} {nm}" for i, nm in enumerate(m.mode_names)),
-            f"contact: {m.contact_name}", "", "methods:"]
+            f"contact: {_contact_line(m)}", "", "methods:"]
     width = max(map(len, m.methods))
     for k, meth in m.methods.items():
         modes = ", ".join(m.mode_names[i] for i in meth.modes) if meth.modes else "all"

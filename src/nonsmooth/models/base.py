@@ -451,6 +451,10 @@ class Model:
             else:
                 raise ParameterError(f"{p.name}: required by model {self.name!r} "
                                      f"({p.long_name or 'no default'}; {p.range_text})")
+        fp = self.forcing_param
+        if fp is not None and not out[fp] > 0:  # (a plain number's range is any finite value)
+            what = "period" if self.period is not None else "frequency"
+            raise ParameterError(f"{fp}: the forcing {what} must be > 0, got {out[fp]:g}")
         if self.check is not None:
             self.check(out)
         return out
