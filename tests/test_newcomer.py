@@ -207,6 +207,11 @@ def test_every_command_refuses_bad_options_before_the_kernels_load(tmp_path):
         (["map", "--start", "sideways", "-o", "a.nc"], "start: expected one of"),
         (["attractors", "--grid", "0", "-o", "a.nc"], "grid: must be >= 2"),
         (["attractors", "--v", "1", "1", "-o", "a.nc"], "v: empty or reversed range"),
+        # a newcomer: the error named --from / --to, which this command does not have
+        (["continue", "--two-param", "omega_s", "--values", "7", "3", "5", "--special", "fold"],
+         "values: empty or reversed omega_s values: FROM 7 must be < TO 3"),
+        (["continue", "--two-param", "omega_s", "--values", "3", "7", "1", "--special", "fold"],
+         "values: N must be >= 2"),
     ]
     got = _in_a_fresh_process([argv for argv, _ in cases], tmp_path)
     for (argv, msg), (c, loaded, err) in zip(cases, got):

@@ -119,7 +119,7 @@ def resolve_workers(workers: int | None) -> int:
     if workers is None or workers == 0:
         return n_max
     if not isinstance(workers, (int, np.integer)) or workers < 0:
-        raise ParameterError(f"workers: must be a positive integer, got {workers!r}")
+        raise ParameterError(f"workers: must be a positive integer (0: all cores), got {workers!r}")
     return int(min(workers, n_max))
 
 

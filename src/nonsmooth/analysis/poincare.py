@@ -261,7 +261,8 @@ def poincare(params: ParamsBase, *, record: int | None = None, transient: int, x
     estimate on a terminal, plain lines elsewhere; or a callable ``progress(done, total)``) is
     called between time slices.
 
-    ``lyapunov`` (None = where tangent dynamics exist, i.e. not for eq. 12): also ``lambda1`` (largest Lyapunov exponent, per unit time) with its
+    ``lyapunov`` (None, the default: yes; every model and method has tangent dynamics): also
+    ``lambda1`` (largest Lyapunov exponent, per unit time) with its
     ``lambda1_stderr`` over ``record`` further periods of the attractor reached (tangent
     dynamics with saltation matrices, ``analysis.stability``), and ``motion``: periodic (a
     period was found), chaotic (lambda1 > 0 beyond 3 standard errors), quasi-periodic (no

@@ -50,16 +50,22 @@ def value_range(lo: float, hi: float, steps: int, name: str = "range", branches:
                 record: int = 0, field: str = "steps"):
     """Evenly spaced values lo ... hi (validated: finite, lo < hi, steps >= 2; ``steps`` values
     of ``branches`` sweeps recording ``record`` periods each must fit in memory, checked
-    before the values are built)."""
+    before the values are built). ``field``: the option that gave ``steps``; an option of
+    its own ("values": FROM TO N in one option) gives all three, and the errors name it."""
     import numpy as np
     from ..checks import check_sweep_memory
+    one = field != "steps"  # FROM TO N in one option, ``field``
     for end, v in (("from", lo), ("to", hi)):
         if not math.isfinite(v):
-            raise ParameterError(f"{end}: must be finite, got {v}")
+            raise ParameterError(f"{field}: {end.upper()} must be finite, got {v}" if one
+                                 else f"{end}: must be finite, got {v}")
     if not lo < hi:
-        raise ParameterError(f"from/to: empty or reversed {name}: --from {lo:g} must be < --to {hi:g}")
+        raise ParameterError(
+            f"{field}: empty or reversed {name}: FROM {lo:g} must be < TO {hi:g}" if one
+            else f"from/to: empty or reversed {name}: --from {lo:g} must be < --to {hi:g}")
     if steps < 2:
-        raise ParameterError(f"steps: must be >= 2, got {steps}")
+        raise ParameterError(f"{field}: N must be >= 2, got {steps}" if one
+                             else f"steps: must be >= 2, got {steps}")
     check_sweep_memory(steps, branches, record, field)
     return np.linspace(lo, hi, steps)
 
@@ -139,7 +145,8 @@ def motion_text(ds) -> str:
     verdict and lambda1 (a periodic one says nothing more than its period)."""
     if "motion" not in ds or int(ds.period) > 0:
         return ""
-    word = ds.motion.attrs["flag_meanings"].split()[int(ds.motion)].replace("_", "-")
+    from ..plot.poincare import motion_word
+    word = motion_word(ds)
     lam = f" (lambda1 = {float(ds.lambda1):.3g} 1/s)" if "lambda1" in ds else ""
     return f": {word}{lam}"
 

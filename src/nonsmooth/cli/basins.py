@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 from typing import Annotated, Optional
 
@@ -100,11 +101,14 @@ def basins_cmd(
                    f"fraction {float(ds.fraction[k]):.4f}")
     if ent is not None:
         sbb = float(ent.boundary_basin_entropy)
+        alpha = float(ent.uncertainty_exponent)
         typer.echo(f"  basin entropy S_b = {float(ent.basin_entropy):.4f}, boundary S_bb = "
                    f"{sbb:.4f} ({'> ln 2: the boundary is fractal' if sbb > 0.6931471805599453 else '<= ln 2: no fractal boundary shown'}; "
                    f"{box}x{box}-cell boxes), uncertainty exponent alpha = "
-                   f"{float(ent.uncertainty_exponent):.3f} +- "
-                   f"{float(ent.uncertainty_exponent_stderr):.3f} (1: smooth boundary)")
+                   + (f"{alpha:.3f} +- {float(ent.uncertainty_exponent_stderr):.3f} "
+                      "(1: smooth boundary)" if math.isfinite(alpha) else
+                      ("not defined (one basin: no boundary)" if n <= 1 else
+                       "not defined (boxes meet a boundary at fewer than two sizes)")))
     for w in caught:
         typer.echo(f"  warning: {w.message}".replace("basins: ", ""))
     echo_written(out, plot, orbits_plot, entropy_plot)

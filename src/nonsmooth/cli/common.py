@@ -48,7 +48,7 @@ ShowOpt = Annotated[Optional[str], typer.Option(
     "--show", show_default=False,
     help="the two state components the figure shows, A,B (e.g. X,Y for impact_2dof); default: "
          "the first two (X, V)")]
-WorkersOpt = Annotated[Optional[int], typer.Option("--workers", "-j", help="threads (default: all cores)")]
+WorkersOpt = Annotated[Optional[int], typer.Option("--workers", "-j", help="threads (default, or 0: all cores)")]
 DaskOpt = Annotated[Optional[str], typer.Option(
     "--dask", show_default=False,
     help="run the chunks on a Dask cluster: a scheduler address (tcp://host:8786), or local "

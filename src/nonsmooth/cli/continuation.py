@@ -85,7 +85,8 @@ def continue_cmd(
     section: Annotated[Optional[str], typer.Option(
         "--section", show_default=False,
         help="limit cycles of a self-excited system on this section surface (an expression "
-             "affine in the state, e.g. V; default V for a model without forcing): --k is "
+             "in the state, parameters allowed, e.g. V or 'X**2 + V**2 - 4'; default V for a "
+             "model without forcing): --k is "
              "then crossings per cycle and --transient crossings before the first Newton "
              "search")] = None,
     crossing: Annotated[str, typer.Option(

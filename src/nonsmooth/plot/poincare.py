@@ -8,10 +8,20 @@ from .common import (draw_model_lines, model_of, new_figure, param_title, scatte
                      shown_components)
 
 
+def motion_word(ds) -> str:
+    """The verdict of ``ds.motion`` in words ("chaotic", "quasi-periodic", "not settled", as
+    ``analysis.stability.VERDICTS``), from its CF flag meanings."""
+    word = ds["motion"].attrs["flag_meanings"].split()[int(ds["motion"])]
+    return word.replace("quasi_", "quasi-").replace("_", " ")
+
+
 def _period_text(ds) -> str:
     p = int(ds["period"])
-    kind = (f"period-{p}" if p > 0 else "not periodic (chaotic or quasi-periodic)" if p == 0
-            else "not settled (still converging)")
+    if p == 0 and "motion" in ds and int(ds["motion"]) > 0:  # the lambda1 verdict
+        kind = f"not periodic: {motion_word(ds)}"
+    else:
+        kind = (f"period-{p}" if p > 0 else "not periodic (chaotic or quasi-periodic)" if p == 0
+                else "not settled (still converging)")
     contact = "contact" if int(ds["contact"]) else "no contact"
     return f"{kind}, {contact}"
 

@@ -28,7 +28,8 @@ def plot_time_response(ds, show=None):
     """Figure with X(t) (left) and the phase portrait V(X) (middle), coloured by the model's
     modes, with the model's lines of X drawn (support, smooth method: the band edges
     h_alpha = +-eta and h_beta = +-eta) and a zoom on the switching zone (right: around the
-    model's first line, in the (X, V) plane). Modes visited only between two samples
+    model's first line, in the (X, V) plane, whatever ``show``: the lines are values of X).
+    Modes visited only between two samples
     (``visited`` mask) are marked with rings, so the figure shows every mode the trajectory
     visited. ``show`` = (a, b), two state component names (or "a,b"): the left panel shows
     a(t) and the middle one b(a) instead (a model with more than two components)."""
@@ -63,7 +64,8 @@ def plot_time_response(ds, show=None):
                 pad = 0.1 * (vmax - vmin + 1e-9)
                 ax.set_xlim(x1 - w, x1 + w)
                 ax.set_ylim(vmin - pad, vmax + pad)
-            ax.set_title("zoom on the switching bands")
+            ax.set_title("zoom on the switching bands" if eta > 0.0 else
+                         f"zoom near the {lines[0][1]}, (X, V)" if lines else "(X, V)")
         else:
             ax.set_title("phase portrait")
         if zoom or ia == 0:
