@@ -19,8 +19,9 @@ SectionOpt = Annotated[str, typer.Option(
     "--section", help="section surface, an expression in the state (parameters "
                       "allowed), e.g. V, 'X - 0.5' or 'X**2 + V**2 - 4'")]
 DirectionOpt = Annotated[str, typer.Option(
-    "--direction", "--crossing", help="crossings counted: decreasing (the surface's expression goes from "
-                        "positive to negative), increasing or both")]
+    "--direction", "--crossing",
+    help="crossings counted: decreasing (the surface's expression goes from positive to "
+         "negative), increasing or both")]
 
 MaxTimeOpt = Annotated[float, typer.Option(
     "--max-time", help="time allowed to reach the next crossing")]
