@@ -210,6 +210,8 @@ def test_every_command_refuses_bad_options_before_the_kernels_load(tmp_path):
         # a newcomer: the error named --from / --to, which this command does not have
         (["continue", "--param", "omega", "--two-param", "omega_s", "--values", "7", "3", "5",
           "--special", "fold"], "values: empty or reversed omega_s values: FROM 7 must be < TO 3"),
+        (["bifurcation", "--workers", "-3", "-o", "a.nc"],
+         "workers: must be a positive integer (0: all cores), got -3"),
     ]
     got = _in_a_fresh_process([argv for argv, _ in cases], tmp_path)
     for (argv, msg), (c, loaded, err) in zip(cases, got):

@@ -48,7 +48,18 @@ ShowOpt = Annotated[Optional[str], typer.Option(
     "--show", show_default=False,
     help="the two state components the figure shows, A,B (e.g. X,Y for impact_2dof); default: "
          "the first two (X, V)")]
-WorkersOpt = Annotated[Optional[int], typer.Option("--workers", "-j", help="threads (default, or 0: all cores)")]
+
+
+def _workers_value(value: Optional[int]) -> Optional[int]:
+    """--workers, checked with the other options (before the kernels load): None or 0 = all
+    cores, else a positive count (``sweep.resolve_workers``)."""
+    if value is not None and value < 0:
+        raise ParameterError(f"workers: must be a positive integer (0: all cores), got {value}")
+    return value
+
+
+WorkersOpt = Annotated[Optional[int], typer.Option("--workers", "-j", callback=_workers_value,
+                                                   help="threads (default, or 0: all cores)")]
 DaskOpt = Annotated[Optional[str], typer.Option(
     "--dask", show_default=False,
     help="run the chunks on a Dask cluster: a scheduler address (tcp://host:8786), or local "
