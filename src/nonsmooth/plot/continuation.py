@@ -214,9 +214,10 @@ def plot_continuation(ds, var: str = "max_X", ax=None):
     a = ds.attrs
     k = int(a.get("k", 1))
     what = f"limit cycles on {a['section']}" if "section" in a else f"period-{k} orbits"
+    rest = param_title(ds, exclude=(param,))  # (empty: the continued parameter is the only one)
     ax.set_title(f"continuation of the {what} in {param}: {lam.size} points, "
-                 f"{nsp} special, {a.get('status', '?')}\n{a.get('method', '')}: "
-                 f"{param_title(ds, exclude=(param,))}", fontsize=9)
+                 f"{nsp} special, {a.get('status', '?')}\n{a.get('method', '')}"
+                 + (f": {rest}" if rest else ""), fontsize=9)
     if own:
         fig.tight_layout()
     return fig
