@@ -201,3 +201,10 @@ def component_pair(pair, names, field: str) -> tuple | None:
             raise ParameterError(f"{field}: unknown component {name!r} (the model has "
                                  f"{', '.join(names)})")
     return tuple(parts)
+
+
+def check_workers(workers) -> None:
+    """``workers`` (threads): None or 0 = all local cores, else a positive integer; one line
+    otherwise (the CLI checks ``--workers`` with its other options, before the kernels load)."""
+    if workers is not None and (not isinstance(workers, (int, np.integer)) or workers < 0):
+        raise ParameterError(f"workers: must be a positive integer (0: all cores), got {workers!r}")

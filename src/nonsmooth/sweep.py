@@ -17,6 +17,7 @@ import time
 import numba as nb
 import numpy as np
 
+from .checks import check_workers
 from .errors import ParameterError
 from .kernels import Solver, tangent_function
 from .integrate.contract import KERNEL_FN_TYPE, MODEL_FNS_TYPE, N_STATE, OPT_N
@@ -116,10 +117,9 @@ class Slicer:
 def resolve_workers(workers: int | None) -> int:
     """Number of threads: ``None`` or 0 = all local cores."""
     n_max = nb.config.NUMBA_NUM_THREADS
+    check_workers(workers)
     if workers is None or workers == 0:
         return n_max
-    if not isinstance(workers, (int, np.integer)) or workers < 0:
-        raise ParameterError(f"workers: must be a positive integer (0: all cores), got {workers!r}")
     return int(min(workers, n_max))
 
 

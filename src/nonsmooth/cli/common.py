@@ -51,10 +51,9 @@ ShowOpt = Annotated[Optional[str], typer.Option(
 
 
 def _workers_value(value: Optional[int]) -> Optional[int]:
-    """--workers, checked with the other options (before the kernels load): None or 0 = all
-    cores, else a positive count (``sweep.resolve_workers``)."""
-    if value is not None and value < 0:
-        raise ParameterError(f"workers: must be a positive integer (0: all cores), got {value}")
+    """--workers, checked with the other options (before the kernels load)."""
+    from ..checks import check_workers
+    check_workers(value)
     return value
 
 
